@@ -1,0 +1,365 @@
+"""Station files: a cell described in TOML, read with tomllib into a frozen `Station`.
+
+Units are SI (m, kg, s, kg/m^3); angles carry their unit in the key (`rpy_deg`, `home_deg`). Paths are
+relative to the station file. Every mistake stops with a StationError naming the file and the key
+(e.g. `stations/x/station.toml: targets[0].inner_diameter: must be below outer_diameter (0.64)`).
+Unknown keys are errors too, so a typo never goes unnoticed. The format is documented in
+`docs/station-format.md`.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import StationError
+
+SHAPES = ("ring", "box", "cylinder", "plane")
+IO_TYPES = ("DI", "DO", "AI", "AO", "GI", "GO")
+
+
+@dataclass(frozen=True)
+class Placement:
+    """A pose: position in m, orientation as roll-pitch-yaw in degrees (fixed axes x, y, z)."""
+
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    @property
+    def rpy(self) -> tuple[float, float, float]:
+        return tuple(math.radians(a) for a in self.rpy_deg)  # type: ignore[return-value]
+
+
+@dataclass(frozen=True)
+class Body:
+    """A target object or a fixture: its shape, size, material and pose."""
+
+    name: str
+    shape: str
+    pose: Placement
+    size: tuple[float, float, float] = (0.0, 0.0, 0.0)  # box
+    radius: float = 0.0  # cylinder
+    outer_diameter: float = 0.0  # ring
+    inner_diameter: float = 0.0  # ring
+    height: float = 0.0  # ring, cylinder
+    segments: int = 24  # ring: the bore and the outside as regular polygons of this many faces
+    density: float = 0.0  # kg/m^3; 0 = static (fixtures only)
+    friction: float = 0.5
+    color: tuple[float, float, float, float] = (0.6, 0.6, 0.65, 1.0)
+
+    @property
+    def dynamic(self) -> bool:
+        return self.density > 0
+
+    @property
+    def volume(self) -> float:
+        if self.shape == "box":
+            return self.size[0] * self.size[1] * self.size[2]
+        if self.shape == "cylinder":
+            return math.pi * self.radius**2 * self.height
+        if self.shape == "ring":
+            return math.pi / 4 * (self.outer_diameter**2 - self.inner_diameter**2) * self.height
+        return 0.0
+
+    @property
+    def mass(self) -> float:
+        return self.density * self.volume
+
+
+@dataclass(frozen=True)
+class JointOverride:
+    velocity: float | None = None
+    effort: float | None = None
+
+
+@dataclass(frozen=True)
+class GripperSpec:
+    urdf: Path
+    mount: Placement  # on the robot's flange, or in the world when the station has no robot
+    tcp: Placement  # tool centre point relative to the flange (or to the mount in the world)
+    always_active: bool = False
+    fingers: tuple[str, ...] | None = None
+    joints: dict[str, JointOverride] = field(default_factory=dict)
+    contact_distance: float = 0.0005  # m: a finger touches a target within this gap
+    friction: float = 0.8
+    initial: dict[str, float] = field(default_factory=dict)  # initial setpoints by input name
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    urdf: Path
+    base: Placement
+    home_deg: tuple[float, ...]
+    flange_link: str = "flange"
+    joints: tuple[str, ...] = ("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6")
+
+
+@dataclass(frozen=True)
+class IOSignal:
+    """A robot-controller signal and its wiring: `drives` a twin input or reads a twin output (`source`)."""
+
+    name: str
+    type: str
+    drives: str | None = None
+    source: str | None = None
+    scale: float = 1.0  # twin value = scale * controller value + offset (and back for `source`)
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    program: Path
+    entry: str
+    io: tuple[IOSignal, ...]
+
+
+@dataclass(frozen=True)
+class Station:
+    file: Path
+    name: str
+    step: float  # s, one simulation step
+    substeps: int  # physics steps inside one simulation step
+    gravity: tuple[float, float, float]
+    gripper: GripperSpec
+    robot: RobotSpec | None
+    targets: tuple[Body, ...]
+    fixtures: tuple[Body, ...]
+    robot_targets: dict[str, Placement]
+    controller: ControllerSpec | None
+
+    @property
+    def folder(self) -> Path:
+        return self.file.parent
+
+
+class _Reader:
+    """Reads one TOML table, checking types and reporting bad keys with their full path."""
+
+    def __init__(self, file: Path, table: dict[str, Any], path: str):
+        self.file, self.table, self.path = file, table, path
+        self.used: set[str] = set()
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def error(self, name: str, message: str) -> StationError:
+        return StationError(str(self.file), self.key(name), message)
+
+    def has(self, name: str) -> bool:
+        return name in self.table
+
+    def get(self, name: str, kind: type | tuple, default: Any = ..., *, check=None) -> Any:
+        self.used.add(name)
+        if name not in self.table:
+            if default is ...:
+                raise self.error(name, "is required")
+            return default
+        value = self.table[name]
+        kinds = kind if isinstance(kind, tuple) else (kind,)
+        if float in kinds and isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        if not isinstance(value, kinds) or (isinstance(value, bool) and bool not in kinds):
+            names = " or ".join(k.__name__ for k in kinds).replace("float", "number").replace("str", "string")
+            raise self.error(name, f"must be a {names}, not {value!r}")
+        if check is not None:
+            problem = check(value)
+            if problem:
+                raise self.error(name, problem)
+        return value
+
+    def number(self, name: str, default: Any = ..., *, positive=False, nonnegative=False) -> float:
+        def check(v):
+            if positive and v <= 0:
+                return f"must be greater than 0, not {v:g}"
+            if nonnegative and v < 0:
+                return f"must not be negative, not {v:g}"
+            return None
+        return self.get(name, float, default, check=check)
+
+    def vector(self, name: str, n: int, default: Any = ...) -> tuple[float, ...]:
+        value = self.get(name, list, default)
+        if value is default:
+            return value
+        if len(value) != n or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            raise self.error(name, f"must be a list of {n} numbers, not {value!r}")
+        return tuple(float(v) for v in value)
+
+    def sub(self, name: str, required=True) -> "_Reader | None":
+        self.used.add(name)
+        if name not in self.table:
+            if required:
+                raise self.error(name, "is required (a table)")
+            return None
+        value = self.table[name]
+        if not isinstance(value, dict):
+            raise self.error(name, "must be a table")
+        return _Reader(self.file, value, self.key(name))
+
+    def items(self, name: str) -> list["_Reader"]:
+        self.used.add(name)
+        value = self.table.get(name, [])
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            raise self.error(name, "must be an array of tables ([[" + self.key(name) + "]])")
+        return [_Reader(self.file, v, f"{self.key(name)}[{i}]") for i, v in enumerate(value)]
+
+    def path_to(self, name: str) -> Path:
+        text = self.get(name, str)
+        path = (self.file.parent / text).resolve()
+        if not path.exists():
+            raise self.error(name, f"file {text!r} not found (looked at {path})")
+        return path
+
+    def done(self) -> None:
+        unknown = [k for k in self.table if k not in self.used]
+        if unknown:
+            raise self.error(unknown[0], "is not a known key here")
+
+
+def _placement(r: _Reader) -> Placement:
+    p = Placement(r.vector("xyz", 3, (0.0, 0.0, 0.0)), r.vector("rpy_deg", 3, (0.0, 0.0, 0.0)))
+    r.done()
+    return p
+
+
+def _placement_key(r: _Reader, name: str) -> Placement:
+    sub = r.sub(name, required=False)
+    return _placement(sub) if sub is not None else Placement()
+
+
+def _body(r: _Reader, is_target: bool) -> Body:
+    name = r.get("name", str)
+    shape = r.get("shape", str, check=lambda v: None if v in SHAPES else f"must be one of {', '.join(SHAPES)}, not {v!r}")
+    if is_target and shape == "plane":
+        raise r.error("shape", "a target cannot be a plane")
+    pose = Placement(r.vector("xyz", 3, (0.0, 0.0, 0.0)), r.vector("rpy_deg", 3, (0.0, 0.0, 0.0)))
+    kw: dict[str, Any] = {}
+    if shape == "box":
+        kw["size"] = r.vector("size", 3)
+        if min(kw["size"]) <= 0:
+            raise r.error("size", "every side must be greater than 0")
+    elif shape == "cylinder":
+        kw["radius"] = r.number("radius", positive=True)
+        kw["height"] = r.number("height", positive=True)
+    elif shape == "ring":
+        kw["outer_diameter"] = od = r.number("outer_diameter", positive=True)
+        kw["inner_diameter"] = r.get(
+            "inner_diameter", float,
+            check=lambda v: None if 0 < v < od else f"must be between 0 and outer_diameter ({od:g}), not {v:g}")
+        kw["height"] = r.number("height", positive=True)
+        kw["segments"] = r.get("segments", int, 24, check=lambda v: None if v >= 6 else "must be at least 6")
+    if is_target:
+        kw["density"] = r.number("density", positive=True)
+    else:
+        kw["density"] = r.number("density", 0.0, nonnegative=True)
+    kw["friction"] = r.number("friction", 0.5, nonnegative=True)
+    color = r.vector("color", 4, None)
+    if color is not None:
+        kw["color"] = color
+    r.done()
+    return Body(name=name, shape=shape, pose=pose, **kw)
+
+
+def load_station(path: str | Path) -> Station:
+    """Read a station from its TOML file, or from a folder holding `station.toml`."""
+    path = Path(path)
+    file = path / "station.toml" if path.is_dir() else path
+    if not file.exists():
+        raise StationError(str(file), "", "no such station file")
+    try:
+        data = tomllib.loads(file.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise StationError(str(file), "", f"not valid TOML: {exc}") from None
+    top = _Reader(file.resolve(), data, "")
+    file = top.file
+
+    st = top.sub("station")
+    name = st.get("name", str, file.parent.name)
+    step = st.number("step", 0.012, positive=True)
+    substeps = st.get("substeps", int, 4, check=lambda v: None if 1 <= v <= 100 else "must be between 1 and 100")
+    gravity = st.vector("gravity", 3, (0.0, 0.0, -9.81))
+    st.done()
+
+    g = top.sub("gripper")
+    joints: dict[str, JointOverride] = {}
+    jt = g.sub("joints", required=False)
+    if jt is not None:
+        for jname in list(jt.table):
+            jr = jt.sub(jname)
+            joints[jname] = JointOverride(jr.number("velocity", None, positive=True), jr.number("effort", None, positive=True))
+            jr.done()
+        jt.done()
+    fingers = g.get("fingers", list, None)
+    if fingers is not None and not all(isinstance(f, str) for f in fingers):
+        raise g.error("fingers", "must be a list of link names")
+    initial_r = g.sub("initial", required=False)
+    initial: dict[str, float] = {}
+    if initial_r is not None:
+        for key in list(initial_r.table):
+            initial[key] = initial_r.number(key)
+        initial_r.done()
+    gripper = GripperSpec(
+        urdf=g.path_to("urdf"),
+        mount=_placement_key(g, "mount"),
+        tcp=_placement_key(g, "tcp"),
+        always_active=g.get("always_active", bool, False),
+        fingers=tuple(fingers) if fingers is not None else None,
+        joints=joints,
+        contact_distance=g.number("contact_distance", 0.0005, positive=True),
+        friction=g.number("friction", 0.8, nonnegative=True),
+        initial=initial,
+    )
+    g.done()
+
+    robot = None
+    rr = top.sub("robot", required=False)
+    robot_targets: dict[str, Placement] = {}
+    if rr is not None:
+        home = rr.get("home_deg", list, [0.0] * 6)
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in home):
+            raise rr.error("home_deg", "must be a list of numbers (degrees)")
+        jn = rr.get("joints", list, list(RobotSpec.joints))
+        robot = RobotSpec(rr.path_to("urdf"), _placement_key(rr, "base"), tuple(float(v) for v in home),
+                          rr.get("flange_link", str, "flange"), tuple(jn))
+        if len(robot.home_deg) != len(robot.joints):
+            raise rr.error("home_deg", f"needs one value per joint ({len(robot.joints)}), has {len(robot.home_deg)}")
+        tr = rr.sub("targets", required=False)
+        if tr is not None:
+            for tname in list(tr.table):
+                robot_targets[tname] = _placement(tr.sub(tname))
+            tr.done()
+        rr.done()
+
+    targets = tuple(_body(r, True) for r in top.items("targets"))
+    fixtures = tuple(_body(r, False) for r in top.items("fixtures"))
+    seen: dict[str, str] = {}
+    for kind, bodies in (("targets", targets), ("fixtures", fixtures)):
+        for i, b in enumerate(bodies):
+            if b.name in seen:
+                raise StationError(str(file), f"{kind}[{i}].name", f"{b.name!r} is already the name of a {seen[b.name]}")
+            seen[b.name] = kind[:-1]
+
+    controller = None
+    cr = top.sub("controller", required=False)
+    if cr is not None:
+        io = []
+        for r in cr.items("io"):
+            sig = IOSignal(
+                name=r.get("name", str),
+                type=r.get("type", str, check=lambda v: None if v in IO_TYPES else f"must be one of {', '.join(IO_TYPES)}"),
+                drives=r.get("drives", str, None),
+                source=r.get("source", str, None),
+                scale=r.number("scale", 1.0),
+                offset=r.number("offset", 0.0),
+            )
+            if sig.drives and sig.type not in ("DO", "AO", "GO"):
+                raise r.error("drives", f"only an output (DO, AO, GO) can drive a twin input; {sig.name} is {sig.type}")
+            if sig.source and sig.type not in ("DI", "AI", "GI"):
+                raise r.error("source", f"only an input (DI, AI, GI) can read a twin output; {sig.name} is {sig.type}")
+            r.done()
+            io.append(sig)
+        controller = ControllerSpec(cr.path_to("program"), cr.get("entry", str, "main"), tuple(io))
+        cr.done()
+    top.done()
+    return Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller)

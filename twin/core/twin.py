@@ -1,0 +1,204 @@
+"""The simulation API: a station's twin, stepped from outside.
+
+`Twin` is what the Modbus server, the RAPID controller and the PLC wrap. Its contract is narrow:
+`read`/`write` signals by name in SI units, `step(n)`, and queries of the physical state. It has no
+sockets and no wall clock; its time is `step_count * dt`. Each step runs, in order: the gripper's servo
+commands and the robot's trajectory (inputs written before the step take effect now), the physics
+sub-steps, then sensing and the grip rule; outputs are then published as one snapshot, so a reader never
+sees a half-updated state. The same station, inputs and step count give the same state, bit for bit.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from .errors import MotionError, SignalError
+from .gripper import IN_POSITION_TOLERANCE, MOVING_SPEED, Gripper
+from .mechanism import Mechanism, load_mechanism
+from .signals import BOOL, ENUM, FLOAT, INPUT, OUTPUT, SignalSpec
+from .station import Station, load_station
+from .world import ROBOT_PREFIX, World
+
+FORCE_UNIT = {"m": "N", "rad": "N*m"}
+
+
+class Twin:
+    """A running station: physics world, gripper logic and robot, with a signal table."""
+
+    def __init__(self, station: Station):
+        self.station = station
+        self.mechanism: Mechanism = load_mechanism(station.gripper.urdf, station.gripper.fingers)
+        self.signals: tuple[SignalSpec, ...] = self._signal_table()
+        self._spec = {s.name: s for s in self.signals}
+        self.world: World | None = None
+        self.reset()
+
+    @classmethod
+    def from_station(cls, path: str | Path) -> "Twin":
+        return cls(load_station(path))
+
+    # -- life cycle -------------------------------------------------------------------------------
+    def reset(self) -> None:
+        """Rebuild the world from the station (never restored from a snapshot: see world.py)."""
+        if self.world is not None:
+            self.world.close()
+        st = self.station
+        self.world = World(st, self.mechanism.base_link)
+        self.step_count = 0
+        self.gripper = Gripper(self.world.client, self.world.machine, self.world.joint_index, self.world.link_index,
+                               self.mechanism, st.gripper, {t.name: self.world.body_ids[t.name] for t in st.targets})
+        self.robot = None
+        if st.robot is not None:
+            from .geometry import Pose
+            from .kinematics import ArmKinematics
+            from .robot import Robot
+
+            base_pos, base_orn = self.world.client.getBasePositionAndOrientation(self.world.machine)
+            tool = Pose.from_xyz_rpy(st.gripper.tcp.xyz, st.gripper.tcp.rpy)
+            self.kinematics = ArmKinematics(st.robot.urdf, base_pos, base_orn, flange_link=st.robot.flange_link, tool=tool)
+            self.robot = Robot(self.world.client, self.world.machine,
+                               tuple(ROBOT_PREFIX + j for j in st.robot.joints), self.kinematics)
+            self.robot.reset([math.radians(a) for a in st.robot.home_deg])
+        self._outputs: dict[str, object] = {}
+        self._publish()
+
+    def close(self) -> None:
+        if self.world is not None:
+            self.world.close()
+            self.world = None
+
+    def __enter__(self) -> "Twin":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- time ---------------------------------------------------------------------------------------
+    @property
+    def dt(self) -> float:
+        return self.station.step
+
+    @property
+    def time(self) -> float:
+        return self.step_count * self.station.step
+
+    def step(self, n: int = 1) -> None:
+        """Advance n simulation steps."""
+        for _ in range(n):
+            self.gripper.command()
+            if self.robot is not None:
+                self.robot.update(self.time)
+            self.world.step()
+            self.step_count += 1
+            self.gripper.sense()
+        self._publish()
+
+    # -- signals ------------------------------------------------------------------------------------
+    def _signal_table(self) -> tuple[SignalSpec, ...]:
+        m, st = self.mechanism, self.station
+        targets = tuple(t.name for t in st.targets)
+        sig = [SignalSpec("Active", INPUT, BOOL, description="gripper enable: while low the fingers hold still"
+                          + (" (this station's gripper is always active)" if st.gripper.always_active else ""))]
+        for inp in m.inputs:
+            sig.append(SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max,
+                                  f"setpoint of {inp.type} joint {inp.joint}"))
+        sig.append(SignalSpec("doGripped", OUTPUT, BOOL, description="every finger touches the same target: it is held"))
+        sig.append(SignalSpec("GrippedPart", OUTPUT, ENUM, description="the held target (none, or one of the target group)",
+                              choices=("",) + targets))
+        for inp in m.inputs:
+            sig.append(SignalSpec(f"{inp.name}.actual", OUTPUT, FLOAT, inp.unit, inp.min, inp.max,
+                                  f"actual position of joint {inp.joint}"))
+            sig.append(SignalSpec(f"{inp.name}.in_position", OUTPUT, BOOL,
+                                  description=f"{inp.name} is within {IN_POSITION_TOLERANCE[inp.unit]:g} {inp.unit} of its setpoint"))
+            sig.append(SignalSpec(f"{inp.name}.moving", OUTPUT, BOOL, description=f"{inp.name} is moving"))
+        for f in m.fingers:
+            unit = FORCE_UNIT["m" if self._joint_unit(f.joint) == "m" else "rad"]
+            sig.append(SignalSpec(f"{f.name}.contact", OUTPUT, BOOL,
+                                  description=f"finger {f.name} touches a target (within {st.gripper.contact_distance * 1000:g} mm)"))
+            sig.append(SignalSpec(f"{f.name}.force", OUTPUT, FLOAT, unit, 0.0, None,
+                                  f"force of finger {f.name}'s servo (magnitude)"))
+        if st.robot is not None:
+            sig.append(SignalSpec("robot.busy", OUTPUT, BOOL, group="robot", description="the robot is executing a motion"))
+            for i, _ in enumerate(st.robot.joints, start=1):
+                sig.append(SignalSpec(f"robot.j{i}", OUTPUT, FLOAT, "rad", group="robot", description=f"robot axis {i} position"))
+        return tuple(sig)
+
+    def _joint_unit(self, joint: str) -> str:
+        for inp in self.mechanism.inputs:
+            if inp.joint == joint:
+                return inp.unit
+        for mim in self.mechanism.mimics:
+            if mim.joint == joint:
+                return self._joint_unit(mim.master)
+        return "m"
+
+    def spec(self, name: str) -> SignalSpec:
+        try:
+            return self._spec[name]
+        except KeyError:
+            raise SignalError(name, "no such signal in station " + repr(self.station.name)) from None
+
+    def read(self, name: str):
+        """Present value of a signal: inputs as last written, outputs as of the last completed step."""
+        spec = self.spec(name)
+        if spec.direction == INPUT:
+            return self.gripper.active if name == "Active" else self.gripper.setpoint[name]
+        return self._outputs[name]
+
+    def write(self, name: str, value) -> None:
+        """Write an input. Takes effect at the next step. Out of range: SignalRangeError, nothing changes."""
+        spec = self.spec(name)
+        if spec.direction != INPUT:
+            raise SignalError(name, "is an output of the twin and cannot be written")
+        if spec.type == BOOL:
+            self.gripper.set_active(bool(value))
+        else:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+                raise SignalError(name, f"needs a number, not {value!r}")
+            self.gripper.set_setpoint(name, float(value))
+
+    def _publish(self) -> None:
+        g, out = self.gripper.state, {}
+        out["doGripped"] = bool(g.gripped)
+        out["GrippedPart"] = g.gripped
+        for inp in self.mechanism.inputs:
+            axis = g.axes[inp.name]
+            out[f"{inp.name}.actual"] = axis.actual
+            out[f"{inp.name}.in_position"] = abs(axis.actual - self.gripper.setpoint[inp.name]) <= IN_POSITION_TOLERANCE[inp.unit]
+            out[f"{inp.name}.moving"] = abs(axis.velocity) > MOVING_SPEED[inp.unit]
+        for name, finger in g.fingers.items():
+            out[f"{name}.contact"] = bool(finger.contacts)
+            out[f"{name}.force"] = finger.force
+        if self.robot is not None:
+            out["robot.busy"] = self.robot.busy(self.time)
+            for i, q in enumerate(self.robot.q, start=1):
+                out[f"robot.j{i}"] = float(q)
+        self._outputs = out
+
+    # -- physical state -----------------------------------------------------------------------------
+    @property
+    def gripped_part(self) -> str:
+        return self.gripper.state.gripped
+
+    def joint_positions(self) -> dict[str, float]:
+        return {name: axis.actual for name, axis in self.gripper.state.axes.items()}
+
+    def finger_contacts(self) -> dict[str, tuple[str, ...]]:
+        return {name: f.contacts for name, f in self.gripper.state.fingers.items()}
+
+    def finger_forces(self) -> dict[str, float]:
+        return {name: f.force for name, f in self.gripper.state.fingers.items()}
+
+    def object_pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """Position (m) and orientation (quaternion x, y, z, w) of a target or fixture."""
+        if name not in self.world.body_ids:
+            raise KeyError(f"no object {name!r} in station {self.station.name!r}")
+        return self.world.pose(name)
+
+    def remove_object(self, name: str) -> None:
+        """Take an object out of the world (e.g. a ring that is not there: a missed-grip scenario)."""
+        uid = self.world.body_ids[name]
+        if self.gripper.state.gripped == name:
+            self.gripper._release()
+        self.world.client.resetBasePositionAndOrientation(uid, [0, 0, -100], [0, 0, 0, 1])
+        self.world.client.changeDynamics(uid, -1, mass=0)

@@ -1,0 +1,150 @@
+"""The physics world: one private pybullet connection holding a station's bodies.
+
+Each World owns its own DIRECT connection (pybullet_utils' BulletClient), so several twins can live in
+one process. Every engine parameter is set explicitly after connecting, because pybullet's
+`resetSimulation` silently resets gravity and solver settings (measured-facts.md). The world is rebuilt
+from scratch rather than restored from a snapshot: `restoreState` is not exact once contacts exist.
+
+The gripper URDF is merged into the robot URDF under the flange link, so arm and gripper are one
+multibody: the gripper moves with the flange with no soft constraint in between. Robot link and joint
+names get the prefix `robot/` so they cannot clash with the gripper's.
+"""
+from __future__ import annotations
+
+import math
+import tempfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+
+from .station import Body, Placement, Station
+
+ROBOT_PREFIX = "robot/"
+
+
+def quat(p: Placement) -> tuple[float, float, float, float]:
+    return tuple(pybullet.getQuaternionFromEuler(p.rpy))  # type: ignore[return-value]
+
+
+def _absolutize_meshes(root: ET.Element, folder: Path) -> None:
+    for elem in root.iter():
+        fname = elem.get("filename")
+        if fname is None:
+            continue
+        if fname.startswith("package://"):
+            fname = fname[len("package://"):].split("/", 1)[-1]
+        if not Path(fname).is_absolute():
+            elem.set("filename", str((folder / fname).resolve()))
+
+
+def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper_urdf: Path, gripper_root: str,
+                             mount: Placement, out_dir: Path) -> Path:
+    """Write one URDF where the gripper's root link hangs off the robot's flange by a fixed joint."""
+    robot = ET.parse(robot_urdf).getroot()
+    gripper = ET.parse(gripper_urdf).getroot()
+    _absolutize_meshes(robot, robot_urdf.parent)
+    _absolutize_meshes(gripper, gripper_urdf.parent)
+    for elem in robot:
+        if elem.tag in ("link", "joint"):
+            elem.set("name", ROBOT_PREFIX + elem.get("name", ""))
+        if elem.tag == "joint":
+            for end in ("parent", "child"):
+                e = elem.find(end)
+                e.set("link", ROBOT_PREFIX + e.get("link", ""))
+            mimic = elem.find("mimic")
+            if mimic is not None:
+                mimic.set("joint", ROBOT_PREFIX + mimic.get("joint", ""))
+    merged = ET.Element("robot", {"name": f"{robot.get('name', 'robot')}+{gripper.get('name', 'gripper')}"})
+    for elem in list(robot) + list(gripper):
+        if elem.tag in ("link", "joint", "material"):
+            merged.append(elem)
+    mount_joint = ET.SubElement(merged, "joint", {"name": "gripper_mount", "type": "fixed"})
+    ET.SubElement(mount_joint, "parent", {"link": ROBOT_PREFIX + flange_link})
+    ET.SubElement(mount_joint, "child", {"link": gripper_root})
+    ET.SubElement(mount_joint, "origin", {"xyz": " ".join(f"{v!r}" for v in mount.xyz),
+                                          "rpy": " ".join(f"{v!r}" for v in mount.rpy)})
+    out = out_dir / "robot_with_gripper.urdf"
+    ET.ElementTree(merged).write(out)
+    return out
+
+
+class World:
+    """A pybullet world built from a station. Owns the connection; `close()` releases it."""
+
+    def __init__(self, station: Station, gripper_root: str):
+        self.station = station
+        self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        self._tmp = tempfile.TemporaryDirectory(prefix="gripper-twin-")
+        self.body_ids: dict[str, int] = {}
+        self._configure()
+        for fixture in station.fixtures:
+            self.body_ids[fixture.name] = self._create_body(fixture)
+        flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+        if station.robot is not None:
+            urdf = merge_gripper_into_robot(station.robot.urdf, station.robot.flange_link, station.gripper.urdf,
+                                            gripper_root, station.gripper.mount, Path(self._tmp.name))
+            base = station.robot.base
+        else:
+            urdf, base = station.gripper.urdf, station.gripper.mount
+        self.machine = self.client.loadURDF(str(urdf), base.xyz, quat(base), useFixedBase=True, flags=flags)
+        self.joint_index: dict[str, int] = {}
+        self.link_index: dict[str, int] = {self.client.getBodyInfo(self.machine)[0].decode(): -1}
+        for j in range(self.client.getNumJoints(self.machine)):
+            info = self.client.getJointInfo(self.machine, j)
+            self.joint_index[info[1].decode()] = j
+            self.link_index[info[12].decode()] = j
+        for target in station.targets:
+            self.body_ids[target.name] = self._create_body(target)
+
+    def _configure(self) -> None:
+        c, st = self.client, self.station
+        c.resetSimulation()
+        c.setGravity(*st.gravity)
+        c.setPhysicsEngineParameter(fixedTimeStep=st.step, numSubSteps=st.substeps, numSolverIterations=50,
+                                    deterministicOverlappingPairs=1)
+
+    def _create_body(self, body: Body) -> int:
+        c = self.client
+        color = list(body.color)
+        if body.shape == "plane":
+            col = c.createCollisionShape(pybullet.GEOM_PLANE)
+            vis = c.createVisualShape(pybullet.GEOM_PLANE, rgbaColor=color)
+        elif body.shape == "box":
+            half = [s / 2 for s in body.size]
+            col = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
+            vis = c.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=color)
+        elif body.shape == "cylinder":
+            col = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=body.radius, height=body.height)
+            vis = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=body.radius, length=body.height, rgbaColor=color)
+        else:  # ring: a compound of boxes; the outside is a regular polygon whose apothem is the outer radius
+            n = body.segments
+            r_out, r_in = body.outer_diameter / 2, body.inner_diameter / 2
+            width = 2 * r_out * math.tan(math.pi / n)
+            half = [(r_out - r_in) / 2, width / 2, body.height / 2]
+            angles = [2 * math.pi * k / n for k in range(n)]
+            positions = [[(r_in + r_out) / 2 * math.cos(a), (r_in + r_out) / 2 * math.sin(a), 0.0] for a in angles]
+            orns = [list(pybullet.getQuaternionFromEuler([0, 0, a])) for a in angles]
+            col = c.createCollisionShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
+                                              collisionFramePositions=positions, collisionFrameOrientations=orns)
+            vis = c.createVisualShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n, rgbaColors=[color] * n,
+                                           visualFramePositions=positions, visualFrameOrientations=orns)
+        uid = c.createMultiBody(baseMass=body.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                                basePosition=body.pose.xyz, baseOrientation=quat(body.pose))
+        c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
+        return uid
+
+    def step(self) -> None:
+        self.client.stepSimulation()
+
+    def pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        pos, orn = self.client.getBasePositionAndOrientation(self.body_ids[name])
+        return tuple(pos), tuple(orn)
+
+    def close(self) -> None:
+        try:
+            self.client.disconnect()
+        except pybullet.error:
+            pass
+        self._tmp.cleanup()
