@@ -11,7 +11,10 @@ names get the prefix `robot/` so they cannot clash with the gripper's.
 """
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -22,6 +25,26 @@ from pybullet_utils.bullet_client import BulletClient
 from .station import Body, Placement, Station
 
 ROBOT_PREFIX = "robot/"
+
+
+@contextlib.contextmanager
+def quiet_native_stdout():
+    """Silence what pybullet's C code prints on stdout (it would corrupt `--json` output)."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, ValueError, OSError):
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(fd)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, fd)
+        yield
+    finally:
+        os.dup2(saved, fd)
+        os.close(saved)
+        os.close(devnull)
 
 
 def quat(p: Placement) -> tuple[float, float, float, float]:
@@ -75,8 +98,12 @@ class World:
 
     def __init__(self, station: Station, gripper_root: str):
         self.station = station
-        self.client = BulletClient(connection_mode=pybullet.DIRECT)
         self._tmp = tempfile.TemporaryDirectory(prefix="gripper-twin-")
+        with quiet_native_stdout():
+            self.client = BulletClient(connection_mode=pybullet.DIRECT)
+            self._build(station, gripper_root)
+
+    def _build(self, station: Station, gripper_root: str) -> None:
         self.body_ids: dict[str, int] = {}
         self._configure()
         for fixture in station.fixtures:

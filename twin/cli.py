@@ -1,0 +1,86 @@
+"""The `twin` command: inspect grippers and stations, run the demo, serve a station on Modbus/TCP.
+
+User errors (a wrong station file, an unknown URDF, a bad signal) print one line on stderr and exit
+with status 2; data goes to stdout.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .core.errors import TwinError
+
+
+def _mechanism_of(target: str):
+    from .core.mechanism import load_mechanism
+    from .core.station import load_station
+
+    path = Path(target)
+    if path.suffix.lower() == ".urdf":
+        return load_mechanism(path)
+    station = load_station(path)
+    return load_mechanism(station.gripper.urdf, station.gripper.fingers)
+
+
+def cmd_info(args) -> int:
+    mech = _mechanism_of(args.target)
+    if args.json:
+        print(json.dumps(mech.as_dict(), indent=2))
+        return 0
+    print(f"gripper: {mech.robot_name} ({mech.urdf})")
+    print(f"base link (attach point): {mech.base_link}")
+    rows = [("input", "joint", "type", "min", "max", "unit")]
+    rows += [(i.name, i.joint, i.type, f"{i.min:g}", f"{i.max:g}", i.unit) for i in mech.inputs]
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    for n, row in enumerate(rows):
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        if n == 0:
+            print("  ".join("-" * w for w in widths))
+    for m in mech.mimics:
+        print(f"mimic: {m.joint} follows {m.master} (x{m.multiplier:g} {m.offset:+g}), no input of its own")
+    print(f"fingers ({len(mech.fingers)}): " + ", ".join(
+        f.name + (f" (+{', '.join(f.links[1:])})" if len(f.links) > 1 else "") for f in mech.fingers))
+    return 0
+
+
+def cmd_demo(args) -> int:
+    from .demo import run_demo
+
+    return run_demo(args.station, cycles=args.cycles)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="twin", description="gripper-twin: a digital twin of a gripper cell")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("info", help="show the inputs, fingers and base link of a gripper URDF or a station's gripper")
+    p.add_argument("target", help="a gripper .urdf file, a station.toml or a station folder")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.set_defaults(func=cmd_info)
+    p = sub.add_parser("demo", help="run the headless demo of the ring rig and print what happens")
+    p.add_argument("station", nargs="?", default=str(Path(__file__).resolve().parent.parent / "stations" / "ring_rig"))
+    p.add_argument("--cycles", type=int, default=1, help="how many full cycles to run")
+    p.set_defaults(func=cmd_demo)
+    try:
+        from .modbus.cli import add_commands
+    except ImportError:
+        pass
+    else:
+        add_commands(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except TwinError as exc:
+        print(f"twin: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
