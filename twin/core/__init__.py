@@ -4,10 +4,18 @@ It imports pybullet and numpy, never sockets, asyncio or time: its clock is step
 """
 
 from .errors import MechanismError, MotionError, SignalError, SignalRangeError, StationError, TwinError
-from .mechanism import Mechanism, load_mechanism
-from .signals import SignalSpec
-from .station import Station, load_station
-from .twin import Twin
 
 __all__ = ["Twin", "Station", "load_station", "Mechanism", "load_mechanism", "SignalSpec", "TwinError",
            "StationError", "MechanismError", "SignalError", "SignalRangeError", "MotionError"]
+
+_LAZY = {"Twin": ".twin", "Station": ".station", "load_station": ".station", "Mechanism": ".mechanism",
+         "load_mechanism": ".mechanism", "SignalSpec": ".signals"}
+
+
+def __getattr__(name: str):
+    """Import lazily, so `twin info` and the CLIs do not pay for (or print) pybullet's import."""
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
+    raise AttributeError(name)

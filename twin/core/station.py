@@ -17,6 +17,7 @@ from typing import Any
 from .errors import StationError
 
 SHAPES = ("ring", "box", "cylinder", "plane")
+MAX_RING_SEGMENTS = 16
 IO_TYPES = ("DI", "DO", "AI", "AO", "GI", "GO")
 
 
@@ -44,7 +45,7 @@ class Body:
     outer_diameter: float = 0.0  # ring
     inner_diameter: float = 0.0  # ring
     height: float = 0.0  # ring, cylinder
-    segments: int = 24  # ring: the bore and the outside as regular polygons of this many faces
+    segments: int = 12  # ring: the bore and the outside as regular polygons of this many faces
     density: float = 0.0  # kg/m^3; 0 = static (fixtures only)
     friction: float = 0.5
     color: tuple[float, float, float, float] = (0.6, 0.6, 0.65, 1.0)
@@ -248,7 +249,8 @@ def _body(r: _Reader, is_target: bool) -> Body:
             "inner_diameter", float,
             check=lambda v: None if 0 < v < od else f"must be between 0 and outer_diameter ({od:g}), not {v:g}")
         kw["height"] = r.number("height", positive=True)
-        kw["segments"] = r.get("segments", int, 24, check=lambda v: None if v >= 6 else "must be at least 6")
+        kw["segments"] = r.get("segments", int, 12, check=lambda v: None if 6 <= v <= MAX_RING_SEGMENTS else
+                               f"must be between 6 and {MAX_RING_SEGMENTS} (a pybullet compound shape holds at most 16 boxes)")
     if is_target:
         kw["density"] = r.number("density", positive=True)
     else:

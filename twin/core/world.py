@@ -30,12 +30,11 @@ ROBOT_PREFIX = "robot/"
 @contextlib.contextmanager
 def quiet_native_stdout():
     """Silence what pybullet's C code prints on stdout (it would corrupt `--json` output)."""
+    fd = 1
     try:
-        fd = sys.stdout.fileno()
+        sys.stdout.flush()
     except (AttributeError, ValueError, OSError):
-        yield
-        return
-    sys.stdout.flush()
+        pass
     saved = os.dup(fd)
     devnull = os.open(os.devnull, os.O_WRONLY)
     try:
@@ -155,7 +154,7 @@ class World:
             orns = [list(pybullet.getQuaternionFromEuler([0, 0, a])) for a in angles]
             col = c.createCollisionShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
                                               collisionFramePositions=positions, collisionFrameOrientations=orns)
-            vis = c.createVisualShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n, rgbaColors=[color] * n,
+            vis = c.createVisualShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
                                            visualFramePositions=positions, visualFrameOrientations=orns)
         uid = c.createMultiBody(baseMass=body.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
                                 basePosition=body.pose.xyz, baseOrientation=quat(body.pose))
