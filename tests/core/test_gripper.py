@@ -34,7 +34,7 @@ def test_parallel_gripper_grips_the_cube_with_its_one_input_and_lets_go_when_ope
         assert twin.read("doGripped") and twin.read("GrippedPart") == "cube"
         # both jaws stopped on the 20 mm cube: the input's actual position is its half width
         assert twin.read("jaw_left.actual") == pytest.approx(0.010, abs=0.0015)
-        assert twin.read("jaw_left.force") > 5.0
+        assert twin.read("jaw_left.force") >= 4.0  # pressing at its 5 N effort limit
         twin.write("jaw_left", 0.025)
         settle(twin, 0.5)
         assert not twin.read("doGripped") and twin.read("GrippedPart") == ""
