@@ -1,0 +1,96 @@
+"""Core benchmark: simulation steps per second, and how the grip check's cost grows with the target group.
+
+    python -m bench core [--steps N]
+
+Table 1: steps per second of the shipped stations, headless, against real time (1 / step).
+Table 2: the four-finger gripper gripping its puck among N extra free cylinders of the target group,
+scattered on the floor. Per step: the whole step, and the grip check (contacts of every finger with the
+targets) done two ways side by side: ours (a broad-phase AABB query, then exact closest points only
+against targets near a finger) and the naive one (closest points against every target).
+"""
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+
+STATIONS = Path(__file__).resolve().parent.parent / "stations"
+
+
+def steps_per_second(station: Path, steps: int) -> tuple[float, float]:
+    from twin.core import Twin
+
+    with Twin.from_station(station) as twin:
+        twin.step(10)
+        t0 = time.perf_counter()
+        twin.step(steps)
+        elapsed = time.perf_counter() - t0
+        return steps / elapsed, 1.0 / twin.dt
+
+
+def crowded_station(folder: Path, extra: int) -> Path:
+    text = (STATIONS / "four_finger" / "station.toml").read_text()
+    text = text.replace('urdf = "gripper4.urdf"', f'urdf = "{STATIONS / "four_finger" / "gripper4.urdf"}"')
+    side = max(1, int(extra ** 0.5) + 1)
+    for k in range(extra):
+        x, y = 0.3 + 0.12 * (k % side), -0.5 + 0.12 * (k // side)
+        text += (f'\n[[targets]]\nname = "c{k}"\nshape = "cylinder"\nradius = 0.03\nheight = 0.04\n'
+                 f'xyz = [{x:.3f}, {y:.3f}, 0.02]\ndensity = 1000.0\n')
+    path = folder / f"crowded_{extra}.toml"
+    path.write_text(text)
+    return path
+
+
+def naive_check(gripper) -> None:
+    c, d = gripper.client, gripper.spec.contact_distance
+    for links in gripper.finger_links.values():
+        for link in links:
+            for uid in gripper.targets.values():
+                c.getClosestPoints(gripper.body, uid, d, linkIndexA=link)
+
+
+def grip_check_costs(extra: int, steps: int) -> dict[str, float]:
+    from twin.core import Twin
+
+    with tempfile.TemporaryDirectory() as tmp, Twin.from_station(crowded_station(Path(tmp), extra)) as twin:
+        for f in ("F1", "F2", "F3", "F4"):
+            twin.write(f, 0.0)
+        twin.step(150)
+        assert twin.read("doGripped"), "the puck should be gripped"
+        t0 = time.perf_counter()
+        twin.step(steps)
+        step_us = (time.perf_counter() - t0) / steps * 1e6
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            for finger in twin.gripper.finger_links:
+                twin.gripper._touching(finger)
+        ours_us = (time.perf_counter() - t0) / steps * 1e6
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            naive_check(twin.gripper)
+        naive_us = (time.perf_counter() - t0) / steps * 1e6
+        return {"step": step_us, "ours": ours_us, "naive": naive_us}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench core")
+    parser.add_argument("--steps", type=int, default=300)
+    args = parser.parse_args(argv)
+    print("Steps per second, headless (one step = servo commands + physics sub-steps + grip check)")
+    print(f"{'station':<16}{'steps/s':>10}{'real time':>12}{'x real time':>13}")
+    for name in ("ring_rig", "smart_gripper", "four_finger"):
+        rate, rt = steps_per_second(STATIONS / name, args.steps)
+        print(f"{name:<16}{rate:>10.0f}{rt:>12.1f}{rate / rt:>13.1f}")
+    print()
+    print("Grip check cost per step vs size of the target group (four_finger holding its puck)")
+    print(f"{'targets':>8}{'step us':>10}{'check us (ours)':>17}{'check us (naive)':>18}{'naive/ours':>12}")
+    for extra in (0, 10, 100, 1000):
+        cost = grip_check_costs(extra, max(20, args.steps // (1 + extra // 100)))
+        print(f"{extra + 1:>8}{cost['step']:>10.0f}{cost['ours']:>17.1f}{cost['naive']:>18.1f}"
+              f"{cost['naive'] / cost['ours']:>12.1f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
