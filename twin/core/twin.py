@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Protocol
 
 from .errors import MotionError, SignalError
 from .gripper import IN_POSITION_TOLERANCE, MOVING_SPEED, Gripper
@@ -22,16 +23,51 @@ from .world import ROBOT_PREFIX, World
 FORCE_UNIT = {"m": "N", "rad": "N*m"}
 
 
+class Device(Protocol):
+    """Something stepped with the twin that adds signals of its own (e.g. the RAPID robot controller).
+
+    The core knows devices only through this protocol, so it never imports what drives it.
+    """
+
+    signals: tuple[SignalSpec, ...]
+
+    def read(self, name: str): ...
+
+    def write(self, name: str, value) -> None: ...
+
+    def before_step(self, twin: "Twin") -> None: ...
+
+    def after_step(self, twin: "Twin") -> None: ...
+
+
 class Twin:
     """A running station: physics world, gripper logic and robot, with a signal table."""
 
     def __init__(self, station: Station):
         self.station = station
         self.mechanism: Mechanism = load_mechanism(station.gripper.urdf, station.gripper.fingers)
-        self.signals: tuple[SignalSpec, ...] = self._signal_table()
-        self._spec = {s.name: s for s in self.signals}
+        self.devices: list[Device] = []
+        self._own_signals = self._signal_table()
+        self._index_signals()
         self.world: World | None = None
         self.reset()
+
+    def _index_signals(self) -> None:
+        signals = list(self._own_signals)
+        self._owner: dict[str, Device | None] = {s.name: None for s in signals}
+        for device in self.devices:
+            for spec in device.signals:
+                if spec.name in self._owner:
+                    raise SignalError(spec.name, "is declared twice (by the station and by a device)")
+                self._owner[spec.name] = device
+                signals.append(spec)
+        self.signals: tuple[SignalSpec, ...] = tuple(signals)
+        self._spec = {s.name: s for s in signals}
+
+    def add_device(self, device: Device) -> None:
+        """Step `device` with the twin and add its signals at the end of the signal table."""
+        self.devices.append(device)
+        self._index_signals()
 
     @classmethod
     def from_station(cls, path: str | Path) -> "Twin":
@@ -85,13 +121,17 @@ class Twin:
     def step(self, n: int = 1) -> None:
         """Advance n simulation steps."""
         for _ in range(n):
+            for device in self.devices:
+                device.before_step(self)
             self.gripper.command()
             if self.robot is not None:
                 self.robot.update(self.time)
             self.world.step()
             self.step_count += 1
             self.gripper.sense()
-        self._publish()
+            self._publish()
+            for device in self.devices:
+                device.after_step(self)
 
     # -- signals ------------------------------------------------------------------------------------
     def _signal_table(self) -> tuple[SignalSpec, ...]:
@@ -141,6 +181,9 @@ class Twin:
     def read(self, name: str):
         """Present value of a signal: inputs as last written, outputs as of the last completed step."""
         spec = self.spec(name)
+        device = self._owner[name]
+        if device is not None:
+            return device.read(name)
         if spec.direction == INPUT:
             return self.gripper.active if name == "Active" else self.gripper.setpoint[name]
         return self._outputs[name]
@@ -150,7 +193,10 @@ class Twin:
         spec = self.spec(name)
         if spec.direction != INPUT:
             raise SignalError(name, "is an output of the twin and cannot be written")
-        if spec.type == BOOL:
+        device = self._owner[name]
+        if device is not None:
+            device.write(name, value)
+        elif spec.type == BOOL:
             self.gripper.set_active(bool(value))
         else:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
