@@ -1,0 +1,21 @@
+"""rapid_like: an interpreter for a subset of ABB RAPID, built to be the robot controller of the twin.
+
+Stages, one per module, dependencies pointing one way:
+
+    tokens, lexer  ->  nodes, parser  ->  checker  ->  interpreter  ->  controller  ->  offline, cli
+                         values, builtins (types, predefined data, pure functions), errors, host
+
+- `parser.parse(source, file)` gives a `nodes.Module` (hand-written recursive descent).
+- `checker.check(module, signals)` finds undefined names, arity and type errors before running.
+- `controller.Controller(module, host, entry)` runs it cooperatively: call `tick(now)` once per
+  simulation step. `host.Host` is the protocol a station binding implements; `host.InMemoryHost`
+  is the offline one.
+- `offline.run_offline(...)` and `cli.main(argv)` are the `rapid run` command.
+"""
+from .controller import Controller, load_program
+from .errors import CheckError, ExecError, LexError, ParseError, RapidError, Span
+from .host import Host, InMemoryHost, MotionRequest, SignalInfo
+from .parser import parse
+
+__all__ = ["Controller", "load_program", "parse", "Host", "InMemoryHost", "MotionRequest", "SignalInfo",
+           "RapidError", "LexError", "ParseError", "CheckError", "ExecError", "Span"]

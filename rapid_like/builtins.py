@@ -1,0 +1,278 @@
+"""Built-ins: the signatures of RAPID's predefined instructions and functions, the pure functions
+themselves (Offs, RelTool, Round, NumToStr, ...), the predefined data (v5..vmax, fine, z0..z200,
+tool0, wobj0, load0) and the error numbers (ERR_DIVZERO, ERR_WAIT_MAXTIME, ...).
+
+Signatures are lists of `nodes.Param`, the same shape as a user routine's, so the checker and the
+evaluator match arguments to parameters with one piece of code (`match_args`). Instructions that
+touch time, signals or motion are executed by the evaluator; only their signatures live here.
+"""
+from __future__ import annotations
+
+import math
+from decimal import ROUND_DOWN, ROUND_HALF_UP, Decimal
+
+from .nodes import Arg, Param
+from .values import Record, record
+
+# ---- error numbers (ERRNO values) ----------------------------------------------------------------
+ERRORS = {
+    "ERR_DIVZERO": 1001,
+    "ERR_WAIT_MAXTIME": 1002,
+    "ERR_ARGNOTPER": 1003,
+    "ERR_FNCNORET": 1004,
+    "ERR_ILLRAISE": 1005,
+    "ERR_ILLDIM": 1006,
+    "ERR_SIGSUPSEARCH": 1007,
+    "ERR_STRTOOLNG": 1008,
+    "ERR_OUTOFBND": 1009,
+    "ERR_ROBLIMIT": 1010,
+    "ERR_INVALID_VALUE": 1011,
+    "ERR_NORUNUNIT": 1012,
+}
+ERR_NAMES = {v: k for k, v in ERRORS.items()}
+USER_ERRNO_BASE = 2000  # BookErrNo hands out numbers from here
+
+
+# ---- predefined data -----------------------------------------------------------------------------
+def _speeds() -> dict[str, Record]:
+    out = {}
+    for v in (5, 10, 20, 30, 40, 50, 60, 80, 100, 150, 200, 300, 400, 500, 600, 800, 1000, 1500, 2000,
+              2500, 3000, 4000, 5000, 6000, 7000):
+        out[f"v{v}"] = record("speeddata", v, 500, 5000, 1000)
+    out["vmax"] = record("speeddata", 5000, 500, 5000, 1000)
+    return out
+
+
+def _zones() -> dict[str, Record]:
+    out = {"fine": record("zonedata", True, 0, 0, 0, 0, 0, 0),
+           "z0": record("zonedata", False, 0.3, 0.3, 0.3, 0.03, 0.3, 0.03),
+           "z1": record("zonedata", False, 1, 1, 1, 0.1, 1, 0.1)}
+    for z in (5, 10, 15, 20, 30, 40, 50, 60, 80, 100, 150, 200):
+        out[f"z{z}"] = record("zonedata", False, z, 1.5 * z, 1.5 * z, 0.15 * z, 1.5 * z, 0.15 * z)
+    return out
+
+
+def predefined_data() -> dict[str, tuple[str, object]]:
+    """lower-case name -> (type, value) of the predefined constants."""
+    data: dict[str, tuple[str, object]] = {}
+    for k, v in _speeds().items():
+        data[k] = ("speeddata", v)
+    for k, v in _zones().items():
+        data[k] = ("zonedata", v)
+    data["tool0"] = ("tooldata", record("tooldata", True, [[0, 0, 0], [1, 0, 0, 0]],
+                                        [0.001, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]))
+    data["wobj0"] = ("wobjdata", record("wobjdata", False, True, "", [[0, 0, 0], [1, 0, 0, 0]],
+                                        [[0, 0, 0], [1, 0, 0, 0]]))
+    data["load0"] = ("loaddata", record("loaddata", 0, [0, 0, 0], [1, 0, 0, 0], 0, 0, 0))
+    for name, num in ERRORS.items():
+        data[name.lower()] = ("errnum", float(num))
+    data["pi"] = ("num", math.pi)
+    return data
+
+
+# ---- signatures ----------------------------------------------------------------------------------
+def _sig(text: str) -> list[Param]:
+    """Parse a compact signature: `num Value, \\num MaxTime, \\INOUT bool TimeFlag, \\switch High`."""
+    params = []
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        optional = part.startswith("\\")
+        words = part.lstrip("\\").split()
+        mode = "IN"
+        if words[0] in ("INOUT", "VAR", "PERS"):
+            mode, words = words[0], words[1:]
+        params.append(Param(None, words[1], words[0], mode, optional))  # type: ignore[arg-type]
+    return params
+
+
+_MOVE_OPTS = r"\num V, \num T, \num Z, \switch Conc, \wobjdata WObj"
+INSTRUCTIONS: dict[str, list[Param]] = {k.lower(): _sig(v) for k, v in {
+    "Incr": "INOUT num Name",
+    "Decr": "INOUT num Name",
+    "Add": "INOUT num Name, num AddValue",
+    "SetDO": r"\num SDelay, signaldo Signal, num Value",
+    "SetAO": "signalao Signal, num Value",
+    "SetGO": "signalgo Signal, num Value",
+    "Set": "signaldo Signal",
+    "Reset": "signaldo Signal",
+    "InvertDO": "signaldo Signal",
+    "PulseDO": r"\switch High, \num PLength, signaldo Signal",
+    "WaitTime": r"\switch InPos, num Time",
+    "WaitDI": r"signaldi Signal, num Value, \num MaxTime, \INOUT bool TimeFlag",
+    "WaitDO": r"signaldo Signal, num Value, \num MaxTime, \INOUT bool TimeFlag",
+    "WaitUntil": r"\switch InPos, bool Cond, \num MaxTime, \INOUT bool TimeFlag, \num PollRate",
+    "WaitRob": r"\switch InPos, \switch ZeroSpeed",
+    "TPWrite": r"string String, \num Num, \bool Bool, \pos Pos, \orient Orient",
+    "TPErase": "",
+    "MoveJ": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
+    "MoveL": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
+    "MoveC": "robtarget CirPoint, robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, "
+             + _MOVE_OPTS,
+    "MoveAbsJ": "jointtarget ToJointPos, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
+    "Stop": r"\switch NoRegain",
+    "Break": "",
+    "ConfJ": r"\switch On, \switch Off",
+    "ConfL": r"\switch On, \switch Off",
+    "VelSet": "num Override, num Max",
+    "AccSet": "num Acc, num Ramp",
+    "BookErrNo": "INOUT errnum ErrorName",
+}.items()}
+
+FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, (s, r) in {
+    "Offs": ("robtarget Point, num XOffset, num YOffset, num ZOffset", "robtarget"),
+    "RelTool": (r"robtarget Point, num Dx, num Dy, num Dz, \num Rx, \num Ry, \num Rz", "robtarget"),
+    "CRobT": (r"\tooldata Tool, \wobjdata WObj", "robtarget"),
+    "CJointT": ("", "jointtarget"),
+    "Present": ("any OptPar", "bool"),
+    "Abs": ("num Input", "num"),
+    "Round": (r"num Val, \num Dec", "num"),
+    "Trunc": (r"num Val, \num Dec", "num"),
+    "Sqrt": ("num Value", "num"),
+    "Pow": ("num Base, num Exponent", "num"),
+    "Exp": ("num Exponent", "num"),
+    "Sin": ("num Angle", "num"),
+    "Cos": ("num Angle", "num"),
+    "Tan": ("num Angle", "num"),
+    "ATan": ("num Value", "num"),
+    "ATan2": ("num Y, num X", "num"),
+    "NumToStr": (r"num Val, num Dec, \switch Exp", "string"),
+    "ValToStr": ("any Val", "string"),
+    "StrLen": ("string Str", "num"),
+    "StrPart": ("string Str, num ChPos, num Len", "string"),
+    "Dist": ("pos Point1, pos Point2", "num"),
+    "DOutput": ("signaldo Signal", "num"),
+    "DInput": ("signaldi Signal", "num"),
+    "AOutput": ("signalao Signal", "num"),
+    "GOutput": ("signalgo Signal", "num"),
+    "TestDI": ("signaldi Signal", "bool"),
+}.items()}
+
+# Functions the evaluator implements itself (they need the host, the frame or the program).
+SPECIAL_FUNCTIONS = {"crobt", "cjointt", "present", "doutput", "dinput", "aoutput", "goutput", "testdi"}
+
+
+def match_args(params: list[Param], args: list[Arg]) -> tuple[dict[str, Arg], str | None, Arg | None]:
+    """Match call arguments to parameters. Returns ({param key: arg}, error message, arg at fault).
+
+    Required arguments match required parameters in order (or by `Name := value`); optional ones
+    (`\\Name`) match optional parameters by name, including `\\a | \\b` alternatives."""
+    required = [p for p in params if not p.optional]
+    optional: dict[str, Param] = {}
+    for p in params:
+        if p.optional:
+            optional[p.key] = p
+            for alt in p.alternatives:
+                optional[alt.key] = alt
+    bound: dict[str, Arg] = {}
+    nreq = 0
+    for a in args:
+        if a.optional:
+            p = optional.get(a.key or "")
+            if p is None:
+                return bound, f"no optional argument \\{a.name}", a
+            if a.key in bound:
+                return bound, f"optional argument \\{a.name} given twice", a
+            group = [p] + p.alternatives
+            for q in params:
+                if q.optional and (q is p or p in q.alternatives):
+                    group = [q] + q.alternatives
+            for other in group:
+                if other.key in bound:
+                    return bound, f"\\{a.name} and \\{other.name} exclude each other", a
+            if p.type == "switch" and a.value is not None:
+                return bound, f"\\{a.name} is a switch and takes no value", a
+            if p.type != "switch" and a.value is None:
+                return bound, f"\\{a.name} needs a value (\\{a.name}:=...)", a
+            bound[p.key] = a
+        elif a.name:
+            match = [p for p in required if p.key == a.key]
+            if not match:
+                return bound, f"no parameter named {a.name}", a
+            bound[match[0].key] = a
+        else:
+            while nreq < len(required) and required[nreq].key in bound:
+                nreq += 1
+            if nreq >= len(required):
+                return bound, f"too many arguments (takes {len(required)})", a
+            bound[required[nreq].key] = a
+            nreq += 1
+    missing = [p.name for p in required if p.key not in bound]
+    if missing:
+        return bound, f"missing argument {missing[0]} (takes {len(required)}: " + \
+            ", ".join(p.name for p in required) + ")", None
+    return bound, None, None
+
+
+# ---- pure functions ------------------------------------------------------------------------------
+def _dec_round(x: float, dec: int, mode: str) -> float:
+    q = Decimal(1).scaleb(-int(dec))
+    return float(Decimal(repr(float(x))).quantize(q, rounding=mode))
+
+
+def rapid_round(x: float, dec: float = 0) -> float:
+    return _dec_round(x, int(dec), ROUND_HALF_UP)
+
+
+def rapid_trunc(x: float, dec: float = 0) -> float:
+    return _dec_round(x, int(dec), ROUND_DOWN)
+
+
+def num_to_str(x: float, dec: float, exp: bool = False) -> str:
+    d = int(dec)
+    if exp:
+        s = f"{x:.{d}E}"
+        mant, e = s.split("E")
+        return f"{mant}E{int(e):+03d}"
+    return f"{rapid_round(x, d):.{d}f}"
+
+
+def qmul(a: list[float], b: list[float]) -> list[float]:
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return [w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
+
+
+def qrotate(q: list[float], v: list[float]) -> list[float]:
+    w, x, y, z = q
+    norm = math.sqrt(w * w + x * x + y * y + z * z) or 1.0
+    w, x, y, z = w / norm, x / norm, y / norm, z / norm
+    r = qmul(qmul([w, x, y, z], [0.0, *v]), [w, -x, -y, -z])
+    return r[1:]
+
+
+def _clean(x: float) -> float:
+    r = round(x, 9)
+    return 0.0 if r == 0 else r
+
+
+def offs(p: Record, dx: float, dy: float, dz: float) -> Record:
+    out = p.copy()
+    t = out.fields["trans"].fields  # type: ignore[union-attr]
+    t["x"], t["y"], t["z"] = t["x"] + dx, t["y"] + dy, t["z"] + dz
+    return out
+
+
+def rel_tool(p: Record, dx: float, dy: float, dz: float, rx: float = 0, ry: float = 0, rz: float = 0) -> Record:
+    """Displace and rotate `p` in its own tool frame; rotations (degrees) about x, then the new y,
+    then the new z."""
+    out = p.copy()
+    t = out.fields["trans"].fields  # type: ignore[union-attr]
+    r = out.fields["rot"].fields  # type: ignore[union-attr]
+    q = [r["q1"], r["q2"], r["q3"], r["q4"]]
+    d = qrotate(q, [dx, dy, dz])
+    t["x"], t["y"], t["z"] = (_clean(t["x"] + d[0]), _clean(t["y"] + d[1]), _clean(t["z"] + d[2]))
+    for angle, axis in ((rx, 0), (ry, 1), (rz, 2)):
+        if angle:
+            h = math.radians(angle) / 2
+            rq = [math.cos(h), 0.0, 0.0, 0.0]
+            rq[1 + axis] = math.sin(h)
+            q = qmul(q, rq)
+    r["q1"], r["q2"], r["q3"], r["q4"] = (_clean(c) for c in q)
+    return out
+
+
+def dist(a: Record, b: Record) -> float:
+    fa, fb = a.fields, b.fields
+    return math.sqrt(sum((fa[k] - fb[k]) ** 2 for k in ("x", "y", "z")))  # type: ignore[operator]

@@ -1,0 +1,445 @@
+"""Static check, run before anything executes: every name resolves (declared data, a routine, a
+predefined constant or a configured I/O signal), built-in and user routines get the right number
+and kinds of arguments, types agree where they can be known, constants and signals are not
+assigned, and RETRY/TRYNEXT appear only in ERROR handlers.
+
+RAPID does not declare signals; the controller's I/O configuration does. The checker gets that
+configuration (`signals`: lower-case name -> SignalInfo) so a misspelt signal is an error here, with
+its line and column, rather than a surprise in the middle of a cycle.
+"""
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+
+from . import builtins as B
+from . import nodes as n
+from .errors import CheckError, Span
+from .host import SignalInfo
+from .values import ATOMIC, KNOWN_TYPES, NUMERIC, RECORDS, SIGNAL_TYPES, base_type
+
+ANY = None  # unknown type: do not complain
+
+
+@dataclass
+class Sym:
+    kind: str  # data, signal, param, loop, switch
+    type: str | None
+    storage: str = "VAR"  # VAR, PERS, CONST
+    signal: SignalInfo | None = None
+
+
+def check(module: n.Module, signals: dict[str, SignalInfo] | None = None) -> None:
+    """Raise CheckError for the first static error in `module`."""
+    Checker(module, signals or {}).run()
+
+
+class Checker:
+    def __init__(self, module: n.Module, signals: dict[str, SignalInfo]):
+        self.module = module
+        self.signals = signals
+        self.globals: dict[str, Sym] = {}
+        self.routines: dict[str, n.Routine] = {}
+        self.predefined = {k: Sym("data", t, "CONST") for k, (t, _) in B.predefined_data().items()}
+
+    # ---- names ---------------------------------------------------------------------------------
+    def err(self, msg: str, span: Span) -> CheckError:
+        return CheckError(msg, span)
+
+    def all_names(self, scope: dict[str, Sym]) -> list[str]:
+        return list(scope) + list(self.globals) + list(self.signals) + list(self.routines)
+
+    def undefined(self, name: str, span: Span, scope: dict[str, Sym], what: str = "") -> CheckError:
+        close = difflib.get_close_matches(name.lower(), self.all_names(scope), n=1)
+        hint = ""
+        if close:
+            real = close[0]
+            if real in self.signals:
+                real = self.signals[real].name
+            elif real in self.routines:
+                real = self.routines[real].name
+            hint = f" (did you mean {real}?)"
+        return self.err(f"undefined name '{name}'{what}: it is not declared data, a routine or a configured "
+                        f"I/O signal{hint}", span)
+
+    def lookup(self, name: str, scope: dict[str, Sym]) -> Sym | None:
+        key = name.lower()
+        if key in scope:
+            return scope[key]
+        if key in self.globals:
+            return self.globals[key]
+        if key in self.predefined:
+            return self.predefined[key]
+        if key == "errno":
+            return Sym("data", "errnum", "CONST")
+        if key in self.signals:
+            return Sym("signal", "num", "CONST", self.signals[key])
+        return None
+
+    def check_type_name(self, t: str, span: Span, allow_signals: bool = False) -> None:
+        if t == "switch":
+            return
+        if t not in KNOWN_TYPES or (t in SIGNAL_TYPES and not allow_signals):
+            close = difflib.get_close_matches(t, sorted(KNOWN_TYPES), n=1)
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            if t in SIGNAL_TYPES:
+                raise self.err(f"signals are configured in the controller's I/O, not declared as data: "
+                               f"{t} can only be a parameter type", span)
+            raise self.err(f"unknown data type '{t}'{hint}", span)
+
+    # ---- module --------------------------------------------------------------------------------
+    def run(self) -> None:
+        for r in self.module.routines:
+            if r.key in self.routines:
+                raise self.err(f"routine {r.name} is declared twice (first on line "
+                               f"{self.routines[r.key].span.line})", r.span)
+            self.routines[r.key] = r
+        for d in self.module.data:
+            self.check_type_name(d.type, d.type_span)
+            if d.key in self.globals or d.key in self.routines:
+                raise self.err(f"{d.name} is declared twice", d.span)
+            if d.key in self.signals:
+                raise self.err(f"{d.name} is already a configured I/O signal", d.span)
+            if d.init is not None:
+                self.expect_type(d.init, d.type, {})
+            self.globals[d.key] = Sym("data", d.type, d.storage)
+        for r in self.module.routines:
+            self.routine(r)
+
+    def routine(self, r: n.Routine) -> None:
+        scope: dict[str, Sym] = {}
+        if r.return_type:
+            self.check_type_name(r.return_type, r.span)
+        for p in r.params:
+            for q in [p, *p.alternatives]:
+                self.check_type_name(q.type, q.span, allow_signals=True)
+                if q.key in scope:
+                    raise self.err(f"parameter {q.name} is declared twice", q.span)
+                kind = "switch" if q.type == "switch" else "param"
+                if q.type in SIGNAL_TYPES:
+                    scope[q.key] = Sym("signal", "num", "CONST", SignalInfo(q.name, SIGNAL_TYPES[q.type]))
+                else:
+                    scope[q.key] = Sym(kind, q.type, "CONST" if kind == "switch" else "VAR")
+        self.current = r
+        self.block(r.body, scope, in_handler=False)
+        if r.error_handler is not None:
+            self.block(r.error_handler, scope, in_handler=True)
+
+    # ---- statements ----------------------------------------------------------------------------
+    def block(self, stmts: list[n.Stmt], scope: dict[str, Sym], in_handler: bool) -> None:
+        for s in stmts:
+            self.stmt(s, scope, in_handler)
+
+    def stmt(self, s: n.Stmt, scope: dict[str, Sym], h: bool) -> None:
+        if isinstance(s, n.LocalDecl):
+            d = s.decl
+            self.check_type_name(d.type, d.type_span)
+            if d.key in scope:
+                raise self.err(f"{d.name} is declared twice in {self.current.name}", d.span)
+            if d.init is not None:
+                self.expect_type(d.init, d.type, scope)
+            scope[d.key] = Sym("data", d.type, d.storage)
+        elif isinstance(s, n.Assign):
+            ttype = self.assign_target(s.target, scope)
+            self.expect_type(s.value, ttype, scope)
+        elif isinstance(s, n.ProcCall):
+            self.proc_call(s, scope)
+        elif isinstance(s, n.If):
+            for cond, body in s.branches:
+                self.expect_type(cond, "bool", scope, what="an IF condition")
+                self.block(body, scope, h)
+            if s.orelse is not None:
+                self.block(s.orelse, scope, h)
+        elif isinstance(s, n.While):
+            self.expect_type(s.cond, "bool", scope, what="a WHILE condition")
+            self.block(s.body, scope, h)
+        elif isinstance(s, n.For):
+            for e in (s.start, s.stop, s.step):
+                if e is not None:
+                    self.expect_type(e, "num", scope, what="a FOR bound")
+            if s.var.lower() in scope:
+                raise self.err(f"the FOR variable {s.var} hides a routine variable of the same name", s.var_span)
+            inner = dict(scope)
+            inner[s.var.lower()] = Sym("loop", "num", "CONST")
+            self.block(s.body, inner, h)
+            for k, v in inner.items():  # declarations inside the loop body stay visible after it
+                if k != s.var.lower() and k not in scope:
+                    scope[k] = v
+        elif isinstance(s, n.Test):
+            t = self.value_type(s.subject, scope)
+            for values, body in s.cases:
+                for v in values:
+                    self.expect_type(v, t, scope)
+                self.block(body, scope, h)
+            if s.default is not None:
+                self.block(s.default, scope, h)
+        elif isinstance(s, n.Return):
+            r = self.current
+            if r.kind == "PROC" and s.value is not None:
+                raise self.err(f"a PROC returns no value: write RETURN; in {r.name}", s.value.span)
+            if r.kind == "FUNC":
+                if s.value is None:
+                    raise self.err(f"RETURN in FUNC {r.name} needs a {r.return_type} value", s.span)
+                self.expect_type(s.value, r.return_type, scope)
+        elif isinstance(s, (n.Retry, n.TryNext)):
+            if not h:
+                word = "RETRY" if isinstance(s, n.Retry) else "TRYNEXT"
+                raise self.err(f"{word} is only allowed in an ERROR handler", s.span)
+        elif isinstance(s, n.Raise):
+            if s.errno is None and not h:
+                raise self.err("RAISE without an error number is only allowed in an ERROR handler", s.span)
+            if s.errno is not None:
+                self.expect_type(s.errno, "errnum", scope)
+        elif isinstance(s, n.Exit):
+            pass
+        else:  # pragma: no cover - the parser makes no other statements
+            raise self.err(f"unknown statement {type(s).__name__}", s.span)
+
+    def assign_target(self, target: n.Expr, scope: dict[str, Sym]) -> str | None:
+        root = target
+        while isinstance(root, n.Component):
+            root = root.obj
+        assert isinstance(root, n.Name)
+        sym = self.lookup(root.name, scope)
+        if sym is None:
+            if root.key in self.routines:
+                raise self.err(f"{root.name} is a routine, not data", root.span)
+            raise self.undefined(root.name, root.span, scope)
+        if sym.kind == "signal":
+            kind = sym.signal.kind if sym.signal else "signal"
+            hint = {"DO": "SetDO", "AO": "SetAO", "GO": "SetGO"}.get(kind)
+            raise self.err(f"{root.name} is a {kind} signal and cannot be assigned"
+                           + (f": use {hint} {root.name}, value;" if hint else ""), root.span)
+        if sym.storage == "CONST":
+            what = "the FOR loop variable" if sym.kind == "loop" else "the constant"
+            if root.key == "errno":
+                what = "the system variable"
+            raise self.err(f"cannot assign to {what} {root.name}", root.span)
+        return self.value_type(target, scope)
+
+    def proc_call(self, s: n.ProcCall, scope: dict[str, Sym]) -> None:
+        key = s.key
+        if key in self.routines:
+            r = self.routines[key]
+            if r.kind != "PROC":
+                raise self.err(f"{r.name} is a FUNC: call it in an expression, e.g. x := {r.name}(...);", s.span)
+            self.args(s.name, r.params, s.args, s.span, scope)
+        elif key in B.INSTRUCTIONS:
+            self.args(s.name, B.INSTRUCTIONS[key], s.args, s.span, scope)
+        elif key in B.FUNCTIONS:
+            raise self.err(f"{s.name} is a function: use its value, e.g. x := {s.name}(...);", s.span)
+        else:
+            sym = self.lookup(s.name, scope)
+            if sym is not None:
+                raise self.err(f"{s.name} is data, not an instruction (did you mean {s.name} := ...;?)", s.span)
+            close = difflib.get_close_matches(key, list(self.routines) + list(B.INSTRUCTIONS), n=1)
+            hint = ""
+            if close:
+                hint = f" (did you mean {self.routines[close[0]].name if close[0] in self.routines else _proper(close[0])}?)"
+            raise self.err(f"unknown instruction or procedure '{s.name}'{hint}", s.span)
+
+    def args(self, name: str, params: list[n.Param], args: list[n.Arg], span: Span,
+             scope: dict[str, Sym]) -> None:
+        bound, msg, bad = B.match_args(params, args)
+        if msg:
+            raise self.err(f"{name}: {msg}", bad.span if bad else span)
+        every = {}
+        for p in params:
+            every[p.key] = p
+            for a in p.alternatives:
+                every[a.key] = a
+        for key, a in bound.items():
+            p = every[key]
+            if a.value is None:
+                continue
+            if p.type in SIGNAL_TYPES:
+                self.signal_arg(name, p, a.value, scope)
+            elif p.type == "any":
+                if name.lower() == "present":
+                    if not (isinstance(a.value, n.Name) and self.lookup(a.value.name, scope)
+                            and self.lookup(a.value.name, scope).kind in ("param", "switch", "signal")
+                            and a.value.key in scope):
+                        raise self.err("Present needs the name of an optional parameter of this routine",
+                                       a.value.span)
+                else:
+                    self.value_type(a.value, scope)
+            elif p.mode in ("INOUT", "VAR", "PERS"):
+                if not isinstance(a.value, (n.Name, n.Component)):
+                    raise self.err(f"{name}: argument {p.name} must be a variable (it is {p.mode})", a.value.span)
+                t = self.assign_target(a.value, scope)
+                if t is not None and base_type(t) != base_type(p.type):
+                    raise self.err(f"type mismatch: {name} argument {p.name} must be a {p.type} variable, "
+                                   f"{a.value.text} is {t}", a.value.span)
+            else:
+                self.expect_type(a.value, p.type, scope, what=f"{name} argument {p.name}")
+
+    def signal_arg(self, name: str, p: n.Param, e: n.Expr, scope: dict[str, Sym]) -> None:
+        want = SIGNAL_TYPES[p.type]
+        if not isinstance(e, n.Name):
+            raise self.err(f"{name}: argument {p.name} must be a {want} signal, found {e.text}", e.span)
+        sym = self.lookup(e.name, scope)
+        if sym is None:
+            raise self.undefined(e.name, e.span, scope)
+        if sym.kind != "signal" or sym.signal is None:
+            raise self.err(f"{name}: argument {p.name} must be a {want} signal, {e.name} is "
+                           f"{sym.type} data", e.span)
+        if sym.signal.kind != want:
+            raise self.err(f"{name}: {e.name} is a {sym.signal.kind} signal, {name} needs a {want}", e.span)
+
+    # ---- expressions ---------------------------------------------------------------------------
+    def expect_type(self, e: n.Expr, want: str | None, scope: dict[str, Sym], what: str = "") -> None:
+        got = self.value_type(e, scope)
+        if want is None or got is None:
+            return
+        if not self.compatible(want, got, e, scope):
+            where = f" in {what}" if what else ""
+            raise self.err(f"type mismatch{where}: expected {want}, found {got}"
+                           + (f" ({e.text})" if len(e.text) <= 40 else ""), e.span)
+
+    def compatible(self, want: str, got: str, e: n.Expr, scope: dict[str, Sym]) -> bool:
+        want, got = base_type(want), base_type(got)
+        if want == got:
+            if want == "aggregate":
+                return True
+            return True
+        if got == "aggregate" and want in RECORDS:
+            assert isinstance(e, n.Aggregate)
+            spec = RECORDS[want]
+            if len(spec) != len(e.items):
+                raise self.err(f"type mismatch: a {want} has {len(spec)} components "
+                               f"({', '.join(f for f, _ in spec)}), the aggregate has {len(e.items)}", e.span)
+            for (fname, ftype), item in zip(spec, e.items):
+                it = self.value_type(item, scope) if not isinstance(item, n.Aggregate) else "aggregate"
+                if isinstance(item, n.Aggregate):
+                    if not self.compatible(ftype, "aggregate", item, scope):
+                        return False
+                elif it is not None and not self.compatible(ftype, it, item, scope):
+                    raise self.err(f"type mismatch in component {fname} of the {want}: expected {ftype}, "
+                                   f"found {it}", item.span)
+            return True
+        return False
+
+    def value_type(self, e: n.Expr, scope: dict[str, Sym]) -> str | None:
+        if isinstance(e, n.NumLit):
+            return "num"
+        if isinstance(e, n.StrLit):
+            return "string"
+        if isinstance(e, n.BoolLit):
+            return "bool"
+        if isinstance(e, n.Aggregate):
+            for item in e.items:
+                if not isinstance(item, n.Aggregate):
+                    self.value_type(item, scope)
+                else:
+                    self.value_type(item, scope)
+            return "aggregate"
+        if isinstance(e, n.Name):
+            sym = self.lookup(e.name, scope)
+            if sym is None:
+                if e.key in self.routines or e.key in B.FUNCTIONS:
+                    raise self.err(f"{e.name} is a routine, not a value (a function call needs "
+                                   f"parentheses: {e.name}(...))", e.span)
+                raise self.undefined(e.name, e.span, scope)
+            if sym.kind == "switch":
+                raise self.err(f"{e.name} is a switch: test it with Present({e.name})", e.span)
+            return sym.type
+        if isinstance(e, n.Component):
+            t = self.value_type(e.obj, scope)
+            if t is None:
+                return None
+            t = base_type(t)
+            if t not in RECORDS:
+                raise self.err(f"{e.obj.text} is a {t} and has no components", e.field_span)
+            for fname, ftype in RECORDS[t]:
+                if fname == e.field.lower():
+                    return ftype
+            raise self.err(f"a {t} has no component '{e.field}' (it has "
+                           f"{', '.join(f for f, _ in RECORDS[t])})", e.field_span)
+        if isinstance(e, n.Unary):
+            t = self.value_type(e.operand, scope)
+            if e.op == "NOT":
+                self.operand(e.operand, t, "bool", "NOT")
+                return "bool"
+            if t is not None and base_type(t) not in ("num", "pos"):
+                raise self.err(f"type mismatch: unary {e.op} needs a num, found {t}", e.operand.span)
+            return t and base_type(t)
+        if isinstance(e, n.Binary):
+            return self.binary_type(e, scope)
+        if isinstance(e, n.Call):
+            return self.call_type(e, scope)
+        raise self.err(f"unknown expression {type(e).__name__}", e.span)  # pragma: no cover
+
+    def operand(self, e: n.Expr, got: str | None, want: str, op: str) -> None:
+        if got is not None and base_type(got) != want:
+            raise self.err(f"type mismatch: {op} needs {want} operands, found {got}", e.span)
+
+    def binary_type(self, e: n.Binary, scope: dict[str, Sym]) -> str | None:
+        lt = self.value_type(e.left, scope)
+        rt = self.value_type(e.right, scope)
+        lb, rb = (base_type(lt) if lt else None), (base_type(rt) if rt else None)
+        op = e.op
+        if op in ("AND", "OR", "XOR"):
+            self.operand(e.left, lt, "bool", op)
+            self.operand(e.right, rt, "bool", op)
+            return "bool"
+        if op in ("=", "<>"):
+            if lb and rb and lb != rb and "aggregate" not in (lb, rb):
+                raise self.err(f"type mismatch: cannot compare {lt} with {rt} using {op}", e.op_span)
+            return "bool"
+        if op in ("<", "<=", ">", ">="):
+            self.operand(e.left, lt, "num", op)
+            self.operand(e.right, rt, "num", op)
+            return "bool"
+        if op == "+" and (lb == "string" or rb == "string"):
+            self.operand(e.left, lt, "string", "string +")
+            self.operand(e.right, rt, "string", "string +")
+            return "string"
+        if op in ("+", "-") and (lb == "pos" or rb == "pos"):
+            self.operand(e.left, lt, "pos", f"pos {op}")
+            self.operand(e.right, rt, "pos", f"pos {op}")
+            return "pos"
+        if op == "*" and (lb in ("pos", "orient") or rb in ("pos", "orient")):
+            if lb == "orient" or rb == "orient":
+                self.operand(e.left, lt, "orient", "orient *")
+                self.operand(e.right, rt, "orient", "orient *")
+                return "orient"
+            if lb == "pos" and rb == "pos":
+                return "pos"
+            return "pos"
+        self.operand(e.left, lt, "num", op)
+        self.operand(e.right, rt, "num", op)
+        return "num"
+
+    def call_type(self, e: n.Call, scope: dict[str, Sym]) -> str | None:
+        key = e.key
+        if key in self.routines:
+            r = self.routines[key]
+            if r.kind != "FUNC":
+                raise self.err(f"{r.name} is a PROC and returns no value: call it as an instruction", e.span)
+            self.args(e.name, r.params, e.args, e.span, scope)
+            return r.return_type
+        if key in B.FUNCTIONS:
+            params, rtype = B.FUNCTIONS[key]
+            self.args(e.name, params, e.args, e.span, scope)
+            return rtype
+        if key in B.INSTRUCTIONS:
+            raise self.err(f"{e.name} is an instruction and returns no value", e.span)
+        close = difflib.get_close_matches(key, list(self.routines) + list(B.FUNCTIONS), n=1)
+        hint = ""
+        if close:
+            hint = f" (did you mean {self.routines[close[0]].name if close[0] in self.routines else _proper(close[0])}?)"
+        raise self.err(f"unknown function '{e.name}'{hint}", e.span)
+
+
+_PROPER = {k.lower(): k for k in (
+    "Incr Decr Add SetDO SetAO SetGO Set Reset InvertDO PulseDO WaitTime WaitDI WaitDO WaitUntil WaitRob TPWrite "
+    "TPErase MoveJ MoveL MoveC MoveAbsJ Stop Break ConfJ ConfL VelSet AccSet BookErrNo Offs RelTool CRobT "
+    "CJointT Present Abs Round Trunc Sqrt Pow Exp Sin Cos Tan ATan ATan2 NumToStr ValToStr StrLen StrPart "
+    "Dist DOutput DInput AOutput GOutput TestDI").split()}
+
+
+def _proper(key: str) -> str:
+    return _PROPER.get(key, key)
+
+
+__all__ = ["check", "Checker", "ATOMIC", "NUMERIC"]

@@ -1,0 +1,153 @@
+"""`rapid`: run or check a RAPID program offline.
+
+    rapid run PROGRAM.mod [--entry NAME] [--io TYPE:NAME,...]... [--set NAME=VALUE[@T]]...
+                          [--max-time T] [--step S] [--trace]
+    rapid check PROGRAM.mod [--io TYPE:NAME,...]...
+
+`--io` plays the controller's I/O configuration (types DI, DO, AI, AO, GI, GO). Without --trace,
+TPWrite lines go to stdout; with --trace every observable event is one JSON object per line.
+Errors go to stderr as `FILE:LINE:COL: error: message` with the source line and a caret.
+Exit status: 0 for a run that ends normally (completed, exit, stop, time_limit), 65 for a syntax
+or static error, 70 for a runtime error, 66 when the file cannot be read, 2 for a usage error.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .errors import RapidError
+from .host import SIGNAL_KINDS, SignalInfo
+from .offline import SignalChange, run_offline
+from .parser import parse
+
+EX_OK, EX_USAGE, EX_DATAERR, EX_NOINPUT, EX_SOFTWARE = 0, 2, 65, 66, 70
+
+
+class UsageError(Exception):
+    pass
+
+
+def parse_io(items: list[str]) -> list[SignalInfo]:
+    out: list[SignalInfo] = []
+    seen: set[str] = set()
+    for item in items:
+        for part in filter(None, (p.strip() for p in item.split(","))):
+            if ":" not in part:
+                raise UsageError(f"--io {part!r}: expected TYPE:NAME, e.g. DI:diGripped")
+            kind, name = (x.strip() for x in part.split(":", 1))
+            kind = kind.upper()
+            if kind not in SIGNAL_KINDS:
+                raise UsageError(f"--io {part!r}: unknown signal type {kind!r} (use {', '.join(SIGNAL_KINDS)})")
+            if not name or not (name[0].isalpha()) or not all(c.isalnum() or c == "_" for c in name):
+                raise UsageError(f"--io {part!r}: {name!r} is not a valid signal name")
+            if name.lower() in seen:
+                raise UsageError(f"--io: signal {name} is configured twice")
+            seen.add(name.lower())
+            out.append(SignalInfo(name, kind))
+    return out
+
+
+def parse_set(items: list[str], signals: list[SignalInfo]) -> list[SignalChange]:
+    known = {s.name.lower(): s for s in signals}
+    out = []
+    for item in items:
+        if "=" not in item:
+            raise UsageError(f"--set {item!r}: expected NAME=VALUE[@T]")
+        name, rest = (x.strip() for x in item.split("=", 1))
+        t = 0.0
+        if "@" in rest:
+            rest, ts = (x.strip() for x in rest.split("@", 1))
+            try:
+                t = float(ts)
+            except ValueError:
+                raise UsageError(f"--set {item!r}: time {ts!r} is not a number") from None
+            if t < 0:
+                raise UsageError(f"--set {item!r}: the time must be >= 0")
+        words = {"true": 1.0, "false": 0.0, "high": 1.0, "low": 0.0}
+        try:
+            value = words[rest.lower()] if rest.lower() in words else float(rest)
+        except ValueError:
+            raise UsageError(f"--set {item!r}: value {rest!r} is not a number") from None
+        if name.lower() not in known:
+            raise UsageError(f"--set {item!r}: {name} is not a configured signal (configure it with --io)")
+        sig = known[name.lower()]
+        if sig.kind in ("DI", "DO") and value not in (0.0, 1.0):
+            raise UsageError(f"--set {item!r}: a digital signal is 0 or 1")
+        out.append(SignalChange(sig.name, value, t))
+    return out
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="rapid", description="Run RAPID programs against in-memory signals.")
+    sub = p.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="run a program offline")
+    chk = sub.add_parser("check", help="parse and check a program without running it")
+    for sp in (run, chk):
+        sp.add_argument("program", help="a RAPID module (.mod)")
+        sp.add_argument("--io", action="append", default=[], metavar="TYPE:NAME,...",
+                        help="configure I/O signals, e.g. DI:diGripped,AO:aoAxis1 (repeatable)")
+        sp.add_argument("--entry", default="main", help="routine to start from (default: main)")
+    run.add_argument("--set", action="append", default=[], metavar="NAME=VALUE[@T]",
+                     help="set a signal at simulated time T seconds (default 0); repeatable")
+    run.add_argument("--max-time", type=float, default=None, metavar="T",
+                     help="end the run at simulated time T (reason time_limit)")
+    run.add_argument("--step", type=float, default=0.012, metavar="S",
+                     help="simulated time of a loop iteration that waits for nothing (default 0.012)")
+    run.add_argument("--trace", action="store_true", help="print every event as one JSON object per line")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    out, err = sys.stdout, sys.stderr
+    path = Path(args.program)
+    try:
+        source = path.read_text(encoding="utf-8")
+    except OSError as e:
+        print(f"{args.program}: error: cannot read the program: {e.strerror or e}", file=err)
+        return EX_NOINPUT
+    try:
+        signals = parse_io(args.io)
+        changes = parse_set(args.set, signals) if args.command == "run" else []
+        if args.command == "run":
+            if args.max_time is not None and args.max_time < 0:
+                raise UsageError("--max-time must be >= 0")
+            if args.step <= 0:
+                raise UsageError("--step must be > 0")
+    except UsageError as e:
+        print(f"rapid: error: {e}", file=err)
+        return EX_USAGE
+
+    def report(e: RapidError) -> None:
+        text = e.render(source)
+        if e.span is None:
+            text = f"{args.program}: {text}"
+        print(text, file=err)
+
+    try:
+        module = parse(source, args.program)
+        if args.command == "check":
+            from .checker import check
+            from .controller import Controller
+            from .host import InMemoryHost
+            check(module, {s.name.lower(): s for s in signals})
+            Controller(module, InMemoryHost(signals), args.entry, autostart=False)
+            return EX_OK
+
+        def on_event(ev: dict) -> None:
+            if args.trace:
+                out.write(json.dumps(ev) + "\n")
+            elif ev["type"] == "print":
+                out.write(ev["text"] + "\n")
+
+        outcome = run_offline(module, signals, changes, args.entry, args.max_time, args.step, on_event)
+    except RapidError as e:
+        report(e)
+        return EX_DATAERR
+    out.flush()
+    if outcome.error is not None:
+        report(outcome.error)
+        return EX_SOFTWARE
+    return EX_OK

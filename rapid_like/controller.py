@@ -1,0 +1,185 @@
+"""The robot controller: a checked RAPID program, a Host, and a tick that whoever owns simulated
+time calls once per step. No threads, no sleeps, no wall clock.
+
+    ctl = Controller(module, host, entry="main", on_event=print, step=None)
+    while ...:
+        ctl.tick(now)          # simulated seconds; runs statements until the program must wait
+
+`tick(now)` first writes the PulseDO edges that are due, then runs the program until it waits
+(WaitTime, WaitUntil, WaitDI/WaitDO, a motion the host has not finished, Stop) or ends. A loop
+iteration that consumed no time also waits for the next tick, so a busy `WHILE` never hangs the
+cell. Time is kept in integer nanoseconds, so five `WaitTime 0.2` end at exactly 1.0 s.
+
+State: `state` is "running", "waiting", "stopped", "completed" or "error" (`error` holds the
+ExecError); `end_reason` is "completed", "exit" or "stop" once the program has ended or stopped.
+`stop()` halts it, `resume()` continues after a stop (or after a Stop instruction), `start()`
+restarts it from the entry routine (VAR data re-initialised, PERS kept).
+
+Events (`on_event(dict)`), each with `t` in seconds rounded to 1 us: output writes
+`{"type": "DO"|"AO"|"GO", "signal", "value"}`, `{"type": "print", "text"}`, motions
+`{"type": "move", "instr", "to", ["via"], "speed", "zone", "tool", "wobj"}`, and last
+`{"type": "end", "reason"}` or `{"type": "error", "line", "col", "message"}`.
+
+A binding to a physics station implements `host.Host` (signals wired to the gripper, motions
+driving the robot, `motion_done` true when the robot is in position) and calls `tick(now)` once
+per control step, after applying its own inputs for `now`. Event-driven runners (the offline CLI)
+use `next_wake_ns()` to jump straight to the next moment anything can happen.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from . import nodes as n
+from .checker import check
+from .errors import CheckError, ExecError, RapidError
+from .host import Host
+from .interpreter import NS, ExitSignal, Fatal, Interpreter, Propagate, Wait, to_ns
+from .parser import parse
+
+RUNNING, WAITING, STOPPED, COMPLETED, ERROR = "running", "waiting", "stopped", "completed", "error"
+
+
+def load_program(path: str | Path) -> n.Module:
+    """Read and parse a .mod file (raises LexError/ParseError)."""
+    path = Path(path)
+    return parse(path.read_text(encoding="utf-8"), str(path))
+
+
+class Controller:
+    def __init__(self, program: n.Module, host: Host, entry: str = "main",
+                 on_event: Callable[[dict], None] | None = None, step: float | None = None,
+                 autostart: bool = True):
+        """`step`: when set, a time-less loop iteration resumes `step` seconds later (event-driven
+        runners); when None it resumes at the next tick (a binding ticking at a fixed rate)."""
+        self.program = program
+        self.host = host
+        self.on_event = on_event
+        self.step_ns = to_ns(step) if step else None
+        signals = {s.name.lower(): s for s in host.signals()}
+        check(program, signals)
+        routine = next((r for r in program.routines if r.key == entry.lower()), None)
+        if routine is None:
+            names = ", ".join(r.name for r in program.routines) or "none"
+            raise CheckError(f"no routine named '{entry}' to start from (routines: {names})", None)
+        if routine.kind != "PROC" or any(not p.optional for p in routine.params):
+            raise CheckError(f"the entry routine {routine.name} must be a PROC without parameters", routine.span)
+        self.entry = routine.name
+        self.interp = Interpreter(program, host, self._emit)
+        self.now = 0
+        self.state = STOPPED
+        self.end_reason: str | None = None
+        self.error: RapidError | None = None
+        self.wait: Wait | None = None
+        self._gen = None
+        self._ended_reported = False
+        self._started = False
+        if autostart:
+            self.start()
+
+    # ---- control ---------------------------------------------------------------------------------
+    def start(self) -> None:
+        """(Re)start from the entry routine; VAR data are re-initialised, PERS data kept."""
+        if self._gen is not None:
+            self._gen.close()
+        self.state, self.end_reason, self.error, self.wait = RUNNING, None, None, None
+        self._ended_reported = False
+        self._gen = None
+        self._init_pending = True
+
+    def stop(self) -> None:
+        """Halt the program where it is (resume() continues, start() restarts)."""
+        if self.state in (RUNNING, WAITING):
+            self.state, self.end_reason = STOPPED, "stop"
+
+    def resume(self) -> None:
+        """Continue after stop() or a Stop instruction."""
+        if self.state == STOPPED and self._gen is not None:
+            if self.wait is not None and self.wait.kind == "stop":
+                self.wait = None
+            self.state, self.end_reason = RUNNING, None
+            self._ended_reported = False
+
+    @property
+    def finished(self) -> bool:
+        """Nothing more will happen without start()/resume(): ended, stopped or failed, no pulse pending."""
+        return self.state in (STOPPED, COMPLETED, ERROR) and not self.interp.pulses
+
+    # ---- time ------------------------------------------------------------------------------------
+    def tick(self, now: float) -> None:
+        self.tick_ns(to_ns(now))
+
+    def tick_ns(self, now: int) -> None:
+        self.now = now
+        self.interp.now = now
+        self.interp.apply_pulses()
+        if self.state in (RUNNING, WAITING):
+            self._run()
+        if self.state in (STOPPED, COMPLETED) and not self.interp.pulses and not self._ended_reported:
+            self._ended_reported = True
+            self._emit({"type": "end", "reason": self.end_reason or "completed"})
+
+    def next_wake_ns(self) -> int | None:
+        """The earliest time the program or a pulse needs a tick, or None (only a signal change can
+        wake it)."""
+        times = [p[0] for p in self.interp.pulses]
+        if self.state == RUNNING:
+            times.append(self.now)
+        elif self.state == WAITING and self.wait is not None and self.wait.at is not None:
+            times.append(self.wait.at)
+        return min(times) if times else None
+
+    # ---- internals -------------------------------------------------------------------------------
+    def _emit(self, event: dict) -> None:
+        if self.on_event is not None:
+            self.on_event({"t": round(self.now / NS, 6), **event})
+
+    def _ready(self, w: Wait) -> bool:
+        if w.kind in ("time", "poll"):
+            return self.now >= (w.at or 0)
+        if w.kind == "step":
+            return w.at is None or self.now >= w.at
+        if w.kind == "stop":
+            return False
+        return True  # signal, motion: re-evaluate on every tick
+
+    def _run(self) -> None:
+        try:
+            if self._gen is None:
+                self.interp.init_data(keep_pers=self._started)
+                self._started = True
+                self._gen = self.interp.run(self.entry)
+            if self.wait is not None and not self._ready(self.wait):
+                self.state = WAITING
+                self.interp.suspensions += 1
+                return
+            while True:
+                self.wait = None
+                w = next(self._gen)
+                if w.kind == "step" and self.step_ns:
+                    w.at = self.now + self.step_ns
+                self.wait = w
+                if w.kind == "stop":
+                    self.state, self.end_reason = STOPPED, "stop"
+                    return
+                if w.kind in ("time", "poll") and self._ready(w):
+                    continue
+                self.state = WAITING
+                self.interp.suspensions += 1
+                return
+        except StopIteration:
+            self.state, self.end_reason = COMPLETED, "completed"
+        except ExitSignal:
+            self.state, self.end_reason = COMPLETED, "exit"
+        except (Fatal, Propagate) as e:
+            self._fail(e.error)
+        except ExecError as e:
+            self._fail(e)
+        self._gen = None if self.state == ERROR else self._gen
+
+    def _fail(self, err: ExecError) -> None:
+        self.state, self.error, self.wait = ERROR, err, None
+        self.interp.pulses.clear()
+        span = err.span
+        self._emit({"type": "error", "line": span.line if span else 0, "col": span.col if span else 0,
+                    "message": err.message})

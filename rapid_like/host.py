@@ -1,0 +1,131 @@
+"""The host protocol: what the controller needs from the world it runs in, and an in-memory host.
+
+The controller never touches physics or sockets. Everything it observes or does to the cell goes
+through a `Host`:
+
+    signals()                      the configured I/O signals (name as configured, type DI/DO/AI/AO/GI/GO)
+    read_signal(name) -> float     a signal's present value, read each time RAPID evaluates it
+    write_signal(name, value)      SetDO/Set/Reset/SetAO/SetGO/PulseDO edges (outputs only)
+    start_motion(request) -> h     begin a MoveJ/MoveL/MoveC/MoveAbsJ; returns any handle
+    motion_done(h) -> bool         asked every tick until True; then the program goes on
+    current_robtarget(tool, wobj)  for CRobT: the TCP of `tool` in `wobj`, a robtarget Record
+    current_jointtarget()          for CJointT
+    tp_write(text)                 a line for the FlexPendant (TPWrite)
+
+Names passed to read/write are the configured spelling. Values are RAPID nums (digital 0/1, analog
+in the controller's unit, e.g. mm). `InMemoryHost` is the offline host: signals live in a dict and a
+motion is complete as soon as it starts (the robot is at its target at once).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol, Sequence, runtime_checkable
+
+from .values import Record, default_value, record
+
+SIGNAL_KINDS = ("DI", "DO", "AI", "AO", "GI", "GO")
+OUTPUT_KINDS = ("DO", "AO", "GO")
+
+
+@dataclass(frozen=True)
+class SignalInfo:
+    """A configured I/O signal: its name as configured and its type (DI, DO, AI, AO, GI, GO)."""
+
+    name: str
+    kind: str
+
+
+@dataclass(frozen=True)
+class MotionRequest:
+    """One motion instruction, with values (records in mm / quaternions) and the identifiers written.
+
+    `target` is a robtarget Record for MoveJ/MoveL/MoveC and a jointtarget Record for MoveAbsJ;
+    `via` is MoveC's circle point (None otherwise). `*_name` are the argument texts as written in
+    the program (`Target_PickOutside`, `v1000`, `fine`, `tcpGripper`, `wobj0` when \\WObj is absent).
+    """
+
+    instr: str
+    target: Record
+    speed: Record
+    zone: Record
+    tool: Record
+    wobj: Record
+    via: Record | None = None
+    target_name: str = ""
+    via_name: str = ""
+    speed_name: str = ""
+    zone_name: str = ""
+    tool_name: str = ""
+    wobj_name: str = "wobj0"
+    line: int = 0
+
+
+@runtime_checkable
+class Host(Protocol):
+    def signals(self) -> Sequence[SignalInfo]: ...
+
+    def read_signal(self, name: str) -> float: ...
+
+    def write_signal(self, name: str, value: float) -> None: ...
+
+    def start_motion(self, request: MotionRequest) -> object: ...
+
+    def motion_done(self, handle: object) -> bool: ...
+
+    def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record: ...
+
+    def current_jointtarget(self) -> Record: ...
+
+    def tp_write(self, text: str) -> None: ...
+
+
+HOME_ROBTARGET = [[0, 0, 0], [1, 0, 0, 0], [0, 0, 0, 0], [9e9] * 6]
+
+
+@dataclass
+class InMemoryHost:
+    """Offline host: signals in a dict (all start at 0), motions complete at once."""
+
+    config: list[SignalInfo]
+    values: dict[str, float] = field(default_factory=dict)
+    printed: list[str] = field(default_factory=list)
+    moves: list[MotionRequest] = field(default_factory=list)
+    position: Record = field(default_factory=lambda: record("robtarget", *HOME_ROBTARGET))
+    joints: Record = field(default_factory=lambda: default_value("jointtarget"))  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        for s in self.config:
+            self.values.setdefault(s.name, 0.0)
+
+    def signals(self) -> Sequence[SignalInfo]:
+        return self.config
+
+    def read_signal(self, name: str) -> float:
+        return self.values[name]
+
+    def write_signal(self, name: str, value: float) -> None:
+        self.values[name] = float(value)
+
+    def set_input(self, name: str, value: float) -> None:
+        """Change any signal from outside (what `--set` does)."""
+        self.values[name] = float(value)
+
+    def start_motion(self, request: MotionRequest) -> object:
+        self.moves.append(request)
+        if request.instr == "MoveAbsJ":
+            self.joints = request.target.copy()
+        else:
+            self.position = request.target.copy()
+        return len(self.moves)
+
+    def motion_done(self, handle: object) -> bool:
+        return True
+
+    def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
+        return self.position.copy()
+
+    def current_jointtarget(self) -> Record:
+        return self.joints.copy()
+
+    def tp_write(self, text: str) -> None:
+        self.printed.append(text)

@@ -1,0 +1,89 @@
+"""Offline runs: a program against an in-memory host, with simulated time advanced from event to
+event (a WaitTime's end, a WaitUntil poll, a `--set` change, a pulse edge), or by one controller
+step for a loop iteration that consumed no time. Nothing waits on the wall clock.
+
+`--set` changes at time T are applied before the program runs at T.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+from . import nodes as n
+from .controller import ERROR, Controller
+from .errors import ExecError
+from .host import InMemoryHost, SignalInfo
+from .interpreter import NS, to_ns
+
+
+@dataclass(frozen=True)
+class SignalChange:
+    """`--set NAME=VALUE@T`: set signal `name` to `value` at `t` seconds."""
+
+    name: str
+    value: float
+    t: float = 0.0
+
+
+@dataclass
+class Outcome:
+    reason: str  # completed, exit, stop, time_limit, error
+    t: float
+    error: ExecError | None = None
+    host: InMemoryHost | None = None
+    events: list[dict] = field(default_factory=list)
+
+
+def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[SignalChange] = (),
+                entry: str = "main", max_time: float | None = None, step: float = 0.012,
+                on_event: Callable[[dict], None] | None = None) -> Outcome:
+    """Run `module` from `entry` until it ends, fails or `max_time` passes. Raises CheckError for
+    static errors (nothing has run then)."""
+    events: list[dict] = []
+
+    def emit(ev: dict) -> None:
+        events.append(ev)
+        if on_event is not None:
+            on_event(ev)
+
+    host = InMemoryHost(list(signals))
+    names = {s.name.lower(): s.name for s in signals}
+    pending = sorted(((to_ns(c.t), i, c) for i, c in enumerate(changes)), key=lambda x: (x[0], x[1]))
+    ctl = Controller(module, host, entry, on_event=emit, step=step)
+    limit = None if max_time is None else to_ns(max_time)
+
+    def apply(now: int) -> None:
+        while pending and pending[0][0] <= now:
+            _, _, c = pending.pop(0)
+            host.set_input(names[c.name.lower()], c.value)
+
+    now = 0
+    apply(now)
+    ctl.tick_ns(now)
+    while not ctl.finished:
+        times = [t for t in (ctl.next_wake_ns(), pending[0][0] if pending else None) if t is not None]
+        if not times:
+            if limit is not None:
+                now = limit
+                break
+            w = ctl.wait
+            what = w.what if w else "the program"
+            err = ExecError(f"{what} waits forever: nothing scheduled can change what it waits for "
+                            f"(give a --set for it, or --max-time)", w.span if w else None, 0)
+            ctl.now = now
+            ctl._fail(err)
+            return Outcome("error", now / NS, err, host, events)
+        nxt = max(min(times), now + 1)
+        if limit is not None and nxt > limit:
+            now = limit
+            break
+        now = nxt
+        apply(now)
+        ctl.tick_ns(now)
+    else:
+        if ctl.state == ERROR:
+            return Outcome("error", now / NS, ctl.error, host, events)  # type: ignore[arg-type]
+        return Outcome(ctl.end_reason or "completed", now / NS, None, host, events)
+    ctl.now = now
+    emit({"t": round(now / NS, 6), "type": "end", "reason": "time_limit"})
+    return Outcome("time_limit", now / NS, None, host, events)

@@ -1,0 +1,527 @@
+"""Parser: tokens to a Module, by hand-written recursive descent.
+
+Hand-written rather than lark because the messages matter more than the grammar's size: a block
+that is not closed is reported at the token where its END word was expected, naming the opener
+("expected ENDIF to close the IF on line 4, found ENDPROC"). The first error stops the parse.
+
+Operator precedence follows the RAPID manual, highest first:
+    * / DIV MOD  >  + -  >  = <> < <= > >=  >  AND  >  OR XOR NOT
+A leading sign applies to the first term (`-a * b` is `-(a * b)`), a relation takes one
+comparison (`a < b < c` is an error) and NOT, the loosest, negates a whole AND-chain
+(`NOT a AND b` is `NOT (a AND b)`).
+"""
+from __future__ import annotations
+
+from . import nodes as n
+from .errors import ParseError, Span
+from .lexer import lex
+from .tokens import Kind, Token
+
+# Words that close a block; a statement never starts with one of them.
+_CLOSERS = {"ENDMODULE", "ENDPROC", "ENDFUNC", "ENDTRAP", "ENDIF", "ELSE", "ELSEIF", "ENDWHILE",
+            "ENDFOR", "ENDTEST", "CASE", "DEFAULT", "ERROR"}
+_RELOPS = ("=", "<>", "<", "<=", ">", ">=")
+
+
+def parse(source: str, file: str = "<input>") -> n.Module:
+    """Parse one RAPID module (a file with or without the MODULE ... ENDMODULE wrapper)."""
+    return Parser(lex(source, file), source, file).module()
+
+
+class Parser:
+    def __init__(self, tokens: list[Token], source: str, file: str):
+        self.toks = tokens
+        self.pos = 0
+        self.source = source
+        self.file = file
+
+    # ---- helpers -------------------------------------------------------------------------------
+    @property
+    def tok(self) -> Token:
+        return self.toks[self.pos]
+
+    def peek(self, k: int = 1) -> Token:
+        return self.toks[min(self.pos + k, len(self.toks) - 1)]
+
+    def advance(self) -> Token:
+        t = self.toks[self.pos]
+        if t.kind is not Kind.EOF:
+            self.pos += 1
+        return t
+
+    def error(self, message: str, span: Span | None = None) -> ParseError:
+        return ParseError(message, span or self.tok.span)
+
+    def after_previous(self) -> Span:
+        """The position just after the previous token (where a missing ';' belongs)."""
+        prev = self.toks[self.pos - 1] if self.pos else self.tok
+        return Span(self.file, prev.span.line, prev.span.col + (prev.end - prev.offset))
+
+    def found(self) -> str:
+        return self.tok.describe()
+
+    def expect_kw(self, word: str, what: str = "") -> Token:
+        if self.tok.is_kw(word):
+            return self.advance()
+        raise self.error(f"expected {word}{what}, found {self.found()}")
+
+    def expect_op(self, op: str, what: str = "", at_previous: bool = False) -> Token:
+        if self.tok.is_op(op):
+            return self.advance()
+        span = self.after_previous() if at_previous else None
+        raise self.error(f"expected '{op}'{what}, found {self.found()}", span)
+
+    def expect_ident(self, what: str) -> Token:
+        if self.tok.kind is Kind.IDENT:
+            return self.advance()
+        if self.tok.kind is Kind.KEYWORD:
+            raise self.error(f"expected {what}, found the reserved word {self.tok.upper}")
+        raise self.error(f"expected {what}, found {self.found()}")
+
+    def end_of_instruction(self) -> None:
+        self.expect_op(";", " at the end of the instruction", at_previous=True)
+
+    def text(self, start: Token) -> str:
+        prev = self.toks[self.pos - 1]
+        return self.source[start.offset:prev.end]
+
+    # ---- module and declarations -----------------------------------------------------------------
+    def module(self) -> n.Module:
+        start = self.tok
+        if self.tok.is_kw("MODULE"):
+            self.advance()
+            name = self.expect_ident("a module name after MODULE").text
+            if self.tok.is_op("("):  # module attributes: (SYSMODULE, NOSTEPIN, ...)
+                while not self.tok.is_op(")"):
+                    if self.tok.kind is Kind.EOF:
+                        raise self.error("expected ')' to close the module attributes")
+                    self.advance()
+                self.advance()
+            data, routines = self.module_items(("ENDMODULE",), f" to close the MODULE on line {start.span.line}")
+            self.expect_kw("ENDMODULE")
+            if self.tok.kind is not Kind.EOF:
+                raise self.error(f"unexpected {self.found()} after ENDMODULE")
+        else:
+            name = "<anonymous>"
+            data, routines = self.module_items((), "")
+        return n.Module(start.span, name, data, routines, self.file, self.source)
+
+    def module_items(self, closers: tuple[str, ...], what: str):
+        data: list[n.DataDecl] = []
+        routines: list[n.Routine] = []
+        while True:
+            t = self.tok
+            if t.kind is Kind.EOF:
+                if closers:
+                    raise self.error(f"expected {closers[0]}{what}, found end of file")
+                return data, routines
+            if closers and t.is_kw(*closers):
+                return data, routines
+            local = False
+            if t.is_kw("LOCAL", "TASK"):
+                local = True
+                self.advance()
+            if self.tok.is_kw("VAR", "PERS", "CONST"):
+                data.append(self.data_decl(local))
+            elif self.tok.is_kw("PROC", "FUNC"):
+                routines.append(self.routine(local))
+            elif self.tok.is_kw("TRAP"):
+                raise self.error("TRAP routines are not supported by this interpreter")
+            elif self.tok.is_kw("ENDMODULE") and not closers:
+                raise self.error("ENDMODULE without MODULE")
+            else:
+                raise self.error(f"expected a data declaration (VAR, PERS, CONST) or a routine (PROC, FUNC)"
+                                 f"{what and ' in the module'}, found {self.found()}")
+
+    def data_decl(self, local: bool = False) -> n.DataDecl:
+        kw = self.advance()
+        storage = kw.upper
+        ttok = self.expect_ident(f"a data type after {storage}")
+        name = self.expect_ident(f"a name for the {ttok.text} {storage.lower()}iable" if storage == "VAR"
+                                 else f"a name for the {ttok.text} {storage}")
+        if self.tok.is_op("{"):
+            raise self.error("arrays are not supported by this interpreter")
+        init = None
+        if self.tok.is_op(":="):
+            self.advance()
+            init = self.expression()
+        elif self.tok.is_op("="):
+            raise self.error("expected ':=' to give an initial value ('=' compares)")
+        elif storage == "CONST":
+            raise self.error(f"expected ':=' and a value for the constant {name.text}", self.after_previous())
+        self.expect_op(";", " at the end of the declaration", at_previous=True)
+        return n.DataDecl(kw.span, storage, ttok.text.lower(), ttok.span, name.text, init, local)
+
+    def routine(self, local: bool) -> n.Routine:
+        kw = self.advance()
+        kind = kw.upper
+        rtype = None
+        if kind == "FUNC":
+            rtype = self.expect_ident("a return type after FUNC").text.lower()
+        name = self.expect_ident(f"a name after {kind}")
+        self.expect_op("(", f" after the {kind} name {name.text}")
+        params = self.params()
+        end = "ENDPROC" if kind == "PROC" else "ENDFUNC"
+        opener = f"{kind} {name.text} on line {kw.span.line}"
+        body = self.block((end, "ERROR"), end, opener)
+        handler = None
+        if self.tok.is_kw("ERROR"):
+            self.advance()
+            handler = self.block((end,), end, opener)
+        self.expect_kw(end)
+        return n.Routine(kw.span, kind, name.text, params, body, handler, rtype, local)
+
+    def params(self) -> list[n.Param]:
+        params: list[n.Param] = []
+        if self.tok.is_op(")"):
+            self.advance()
+            return params
+        while True:
+            if self.tok.is_op("\\"):
+                self.advance()
+                p = self.one_param(optional=True)
+                while self.tok.is_op("|"):
+                    self.advance()
+                    p.alternatives.append(self.one_param(optional=True))
+                params.append(p)
+            else:
+                params.append(self.one_param(optional=False))
+            if self.tok.is_op(")"):
+                self.advance()
+                return params
+            if self.tok.is_op(","):
+                self.advance()
+                continue
+            if self.tok.is_op("\\"):
+                continue
+            raise self.error(f"expected ',' or ')' in the parameter list, found {self.found()}")
+
+    def one_param(self, optional: bool) -> n.Param:
+        start = self.tok
+        mode = "IN"
+        if self.tok.is_kw("VAR", "PERS", "INOUT"):
+            mode = self.advance().upper
+        ttok = self.expect_ident("a parameter type")
+        if ttok.text.lower() == "switch":
+            name = self.expect_ident("a switch name")
+            return n.Param(start.span, name.text, "switch", mode, True)
+        name = self.expect_ident(f"a parameter name after the type {ttok.text}")
+        if self.tok.is_op("{"):
+            raise self.error("array parameters are not supported by this interpreter")
+        return n.Param(start.span, name.text, ttok.text.lower(), mode, optional)
+
+    # ---- statements ------------------------------------------------------------------------------
+    def block(self, closers: tuple[str, ...], expected: str, opener: str) -> list[n.Stmt]:
+        """Statements up to (not including) one of `closers`. Anything else that closes a block is
+        reported as the missing `expected` word of `opener`."""
+        stmts: list[n.Stmt] = []
+        while True:
+            t = self.tok
+            if t.kind is Kind.KEYWORD and t.upper in closers:
+                return stmts
+            if t.kind is Kind.EOF or (t.kind is Kind.KEYWORD and t.upper in _CLOSERS) or t.is_kw("PROC", "FUNC", "ENDMODULE"):
+                raise self.error(f"expected {expected} to close the {opener}, found {self.found()}")
+            stmts.append(self.statement())
+
+    def statement(self) -> n.Stmt:
+        t = self.tok
+        if t.kind is Kind.IDENT:
+            return self.simple_ident_statement()
+        if t.kind is Kind.KEYWORD:
+            w = t.upper
+            if w == "IF":
+                return self.if_stmt()
+            if w == "WHILE":
+                return self.while_stmt()
+            if w == "FOR":
+                return self.for_stmt()
+            if w == "TEST":
+                return self.test_stmt()
+            if w in ("VAR", "PERS", "CONST"):
+                decl = self.data_decl()
+                return n.LocalDecl(decl.span, decl)
+            if w in ("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE"):
+                return self.keyword_instruction()
+            if w == "GOTO":
+                raise self.error("GOTO is not supported by this interpreter")
+        raise self.error(f"expected an instruction, found {self.found()}")
+
+    def keyword_instruction(self) -> n.Stmt:
+        t = self.advance()
+        w = t.upper
+        if w == "RETURN":
+            value = None if self.tok.is_op(";") else self.expression()
+            self.end_of_instruction()
+            return n.Return(t.span, value)
+        if w == "RAISE":
+            value = None if self.tok.is_op(";") else self.expression()
+            self.end_of_instruction()
+            return n.Raise(t.span, value)
+        self.end_of_instruction()
+        return {"EXIT": n.Exit, "RETRY": n.Retry, "TRYNEXT": n.TryNext}[w](t.span)
+
+    def simple_ident_statement(self) -> n.Stmt:
+        start = self.tok
+        if self.peek().is_op(":=", "."):
+            target = self.postfix(self.name_expr())
+            if not self.tok.is_op(":="):
+                if self.tok.is_op("="):
+                    raise self.error("expected ':=' for an assignment ('=' compares)")
+                raise self.error(f"expected ':=' after {target.text}, found {self.found()}")
+            self.advance()
+            value = self.expression()
+            self.end_of_instruction()
+            return n.Assign(start.span, target, value)
+        if self.peek().is_op("{"):
+            raise self.error("arrays are not supported by this interpreter", self.peek().span)
+        if self.peek().is_op("=") and not self.peek(2).is_op("="):
+            raise self.error(f"expected ':=' to assign to {start.text} ('=' compares)", self.peek().span)
+        name = self.advance()
+        args = self.arguments(";", f"the {name.text} instruction")
+        self.end_of_instruction()
+        return n.ProcCall(name.span, name.text, args)
+
+    def arguments(self, closer: str, what: str) -> list[n.Arg]:
+        """Arguments up to `closer` (not consumed). Required arguments are separated by commas;
+        an optional `\\Name[:=value]` may follow with or without a comma."""
+        args: list[n.Arg] = []
+        need_comma = False
+        while not self.tok.is_op(closer):
+            t = self.tok
+            if t.kind is Kind.EOF or (t.kind is Kind.KEYWORD and t.upper in _CLOSERS):
+                break
+            if t.is_op(","):
+                if not args:
+                    raise self.error(f"expected an argument of {what} before ','")
+                self.advance()
+                need_comma = False
+                if self.tok.is_op(closer, ","):
+                    raise self.error(f"expected an argument of {what} after ','")
+                continue
+            if t.is_op("\\"):
+                self.advance()
+                name = self.expect_ident(f"an optional argument name after '\\' in {what}")
+                value = None
+                if self.tok.is_op(":="):
+                    self.advance()
+                    value = self.expression()
+                args.append(n.Arg(t.span, value, name.text, True))
+                need_comma = True
+                continue
+            if need_comma and args and not args[-1].optional:
+                if closer == ";":
+                    raise self.error(f"expected ';' at the end of the instruction, found {self.found()}",
+                                     self.after_previous())
+                raise self.error(f"expected ',' between the arguments of {what}, found {self.found()}")
+            aname = None
+            if t.kind is Kind.IDENT and self.peek().is_op(":="):
+                aname = self.advance().text
+                self.advance()
+            value = self.expression()
+            args.append(n.Arg(t.span, value, aname, False))
+            need_comma = True
+        return args
+
+    def if_stmt(self) -> n.Stmt:
+        kw = self.advance()
+        cond = self.expression()
+        if not self.tok.is_kw("THEN"):
+            # compact IF: IF cond instruction;
+            if self.tok.kind is Kind.IDENT or self.tok.is_kw("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE"):
+                body = [self.statement()]
+                return n.If(kw.span, [(cond, body)], None, compact=True)
+            raise self.error(f"expected THEN after the IF condition, found {self.found()}")
+        self.advance()
+        opener = f"IF on line {kw.span.line}"
+        branches = [(cond, self.block(("ELSEIF", "ELSE", "ENDIF"), "ENDIF", opener))]
+        orelse = None
+        while self.tok.is_kw("ELSEIF"):
+            self.advance()
+            c = self.expression()
+            self.expect_kw("THEN", " after the ELSEIF condition")
+            branches.append((c, self.block(("ELSEIF", "ELSE", "ENDIF"), "ENDIF", opener)))
+        if self.tok.is_kw("ELSE"):
+            self.advance()
+            orelse = self.block(("ENDIF",), "ENDIF", opener)
+        self.expect_kw("ENDIF")
+        return n.If(kw.span, branches, orelse)
+
+    def while_stmt(self) -> n.Stmt:
+        kw = self.advance()
+        cond = self.expression()
+        self.expect_kw("DO", " after the WHILE condition")
+        body = self.block(("ENDWHILE",), "ENDWHILE", f"WHILE on line {kw.span.line}")
+        self.advance()
+        return n.While(kw.span, cond, body)
+
+    def for_stmt(self) -> n.Stmt:
+        kw = self.advance()
+        var = self.expect_ident("a loop variable after FOR")
+        self.expect_kw("FROM", f" after FOR {var.text}")
+        start = self.expression()
+        self.expect_kw("TO", " after the FROM value")
+        stop = self.expression()
+        step = None
+        if self.tok.is_kw("STEP"):
+            self.advance()
+            step = self.expression()
+        self.expect_kw("DO", " after the FOR range")
+        body = self.block(("ENDFOR",), "ENDFOR", f"FOR on line {kw.span.line}")
+        self.advance()
+        return n.For(kw.span, var.text, var.span, start, stop, step, body)
+
+    def test_stmt(self) -> n.Stmt:
+        kw = self.advance()
+        subject = self.expression()
+        opener = f"TEST on line {kw.span.line}"
+        cases: list[tuple[list[n.Expr], list[n.Stmt]]] = []
+        default = None
+        if not self.tok.is_kw("CASE", "DEFAULT"):
+            raise self.error(f"expected CASE or DEFAULT after the TEST value, found {self.found()}")
+        while self.tok.is_kw("CASE"):
+            self.advance()
+            values = [self.expression()]
+            while self.tok.is_op(","):
+                self.advance()
+                values.append(self.expression())
+            self.expect_op(":", " after the CASE values")
+            cases.append((values, self.block(("CASE", "DEFAULT", "ENDTEST"), "ENDTEST", opener)))
+        if self.tok.is_kw("DEFAULT"):
+            self.advance()
+            self.expect_op(":", " after DEFAULT")
+            default = self.block(("ENDTEST",), "ENDTEST", opener)
+        if self.tok.is_kw("CASE"):
+            raise self.error("CASE after DEFAULT: DEFAULT must be the last branch of a TEST")
+        self.expect_kw("ENDTEST", f" to close the {opener}")
+        return n.Test(kw.span, subject, cases, default)
+
+    # ---- expressions -----------------------------------------------------------------------------
+    def expression(self) -> n.Expr:
+        start = self.tok
+        left = self.not_expr()
+        while self.tok.is_kw("OR", "XOR"):
+            op = self.advance()
+            right = self.not_expr()
+            left = n.Binary(start.span, self.text(start), op.upper, left, right, op.span)
+        return left
+
+    def not_expr(self) -> n.Expr:
+        start = self.tok
+        if self.tok.is_kw("NOT"):
+            op = self.advance()
+            operand = self.not_expr()
+            return n.Unary(start.span, self.text(start), "NOT", operand, op.span)
+        return self.and_expr()
+
+    def and_expr(self) -> n.Expr:
+        start = self.tok
+        left = self.relation()
+        while self.tok.is_kw("AND"):
+            op = self.advance()
+            if self.tok.is_kw("NOT"):  # `a AND NOT b`: NOT applies to the relation that follows
+                s2 = self.tok
+                nop = self.advance()
+                inner = self.relation()
+                right: n.Expr = n.Unary(s2.span, self.text(s2), "NOT", inner, nop.span)
+            else:
+                right = self.relation()
+            left = n.Binary(start.span, self.text(start), "AND", left, right, op.span)
+        return left
+
+    def relation(self) -> n.Expr:
+        start = self.tok
+        left = self.simple_expr()
+        if self.tok.is_op(*_RELOPS):
+            op = self.advance()
+            right = self.simple_expr()
+            left = n.Binary(start.span, self.text(start), op.text, left, right, op.span)
+            if self.tok.is_op(*_RELOPS):
+                raise self.error(f"a comparison cannot be chained: write ({left.text}) AND ... instead")
+        return left
+
+    def simple_expr(self) -> n.Expr:
+        start = self.tok
+        if self.tok.is_op("+", "-"):
+            op = self.advance()
+            first = self.term()
+            left: n.Expr = n.Unary(start.span, self.text(start), op.text, first, op.span)
+        else:
+            left = self.term()
+        while self.tok.is_op("+", "-"):
+            op = self.advance()
+            right = self.term()
+            left = n.Binary(start.span, self.text(start), op.text, left, right, op.span)
+        return left
+
+    def term(self) -> n.Expr:
+        start = self.tok
+        left = self.primary()
+        while self.tok.is_op("*", "/") or self.tok.is_kw("DIV", "MOD"):
+            op = self.advance()
+            right = self.primary()
+            opname = op.upper if op.kind is Kind.KEYWORD else op.text
+            left = n.Binary(start.span, self.text(start), opname, left, right, op.span)
+        return left
+
+    def primary(self) -> n.Expr:
+        t = self.tok
+        if t.kind is Kind.NUM:
+            self.advance()
+            return n.NumLit(t.span, t.text, float(t.value))
+        if t.kind is Kind.STRING:
+            self.advance()
+            return n.StrLit(t.span, t.text, str(t.value))
+        if t.is_kw("TRUE", "FALSE"):
+            self.advance()
+            return n.BoolLit(t.span, t.text, t.upper == "TRUE")
+        if t.is_op("+", "-"):  # a sign inside a term, e.g. `a * -1`
+            op = self.advance()
+            operand = self.primary()
+            return n.Unary(t.span, self.text(t), op.text, operand, op.span)
+        if t.is_op("("):
+            self.advance()
+            inner = self.expression()
+            self.expect_op(")", f" to close the '(' on line {t.span.line} col {t.span.col}")
+            inner.text = self.text(t)
+            return inner
+        if t.is_op("["):
+            self.advance()
+            items: list[n.Expr] = []
+            if not self.tok.is_op("]"):
+                items.append(self.expression())
+                while self.tok.is_op(","):
+                    self.advance()
+                    items.append(self.expression())
+            self.expect_op("]", f" to close the '[' on line {t.span.line} col {t.span.col}")
+            return n.Aggregate(t.span, self.text(t), items)
+        if t.kind is Kind.IDENT:
+            if self.peek().is_op("("):
+                name = self.advance()
+                self.advance()
+                args = self.arguments(")", f"{name.text}()")
+                self.expect_op(")", f" to close the call of {name.text}")
+                return self.postfix(n.Call(t.span, self.text(t), name.text, args))
+            return self.postfix(self.name_expr())
+        if t.kind is Kind.KEYWORD:
+            raise self.error(f"expected an expression, found the reserved word {t.upper}")
+        if t.kind is Kind.EOF:
+            raise self.error("expected an expression, found end of file")
+        raise self.error(f"expected an expression, found {self.found()}")
+
+    def name_expr(self) -> n.Name:
+        t = self.advance()
+        return n.Name(t.span, t.text, t.text)
+
+    def postfix(self, expr: n.Expr) -> n.Expr:
+        start_off = None
+        while self.tok.is_op("."):
+            self.advance()
+            f = self.expect_ident("a component name after '.'")
+            text = self.source[self._offset_of(expr):f.end]
+            expr = n.Component(expr.span, text, expr, f.text, f.span)
+        del start_off
+        return expr
+
+    def _offset_of(self, expr: n.Expr) -> int:
+        lines = self.source.splitlines(keepends=True)
+        return sum(len(x) for x in lines[: expr.span.line - 1]) + expr.span.col - 1

@@ -1,0 +1,215 @@
+"""Values and data types: atomic num/bool/string, records (robtarget, tooldata, ...) and signals.
+
+A num is a Python float, a bool a bool, a string a str. A record is a `Record`: a type name and its
+components in declaration order. RAPID data has value semantics, so a record is copied whenever it
+is assigned or passed by value (`Record.copy`). An aggregate literal `[...]` has no type of its own;
+`coerce` gives it the type of the place it goes to.
+
+A signal used in an expression reads as its present value (a num); passed to a `signaldo` (etc.)
+parameter it is a `SignalRef`, so SetDO writes the signal itself.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+NUM, BOOL, STRING = "num", "bool", "string"
+NUMERIC = {"num", "dnum", "errnum", "intnum"}
+ATOMIC = NUMERIC | {BOOL, STRING}
+SIGNAL_TYPES = {"signaldi": "DI", "signaldo": "DO", "signalai": "AI", "signalao": "AO",
+                "signalgi": "GI", "signalgo": "GO"}
+SIGNAL_KINDS = {v: k for k, v in SIGNAL_TYPES.items()}
+
+_N = NUM
+# Record types: component names and types, in order (as in the RAPID manual).
+RECORDS: dict[str, list[tuple[str, str]]] = {
+    "pos": [("x", _N), ("y", _N), ("z", _N)],
+    "orient": [("q1", _N), ("q2", _N), ("q3", _N), ("q4", _N)],
+    "pose": [("trans", "pos"), ("rot", "orient")],
+    "confdata": [("cf1", _N), ("cf4", _N), ("cf6", _N), ("cfx", _N)],
+    "extjoint": [(f"eax_{c}", _N) for c in "abcdef"],
+    "robjoint": [(f"rax_{i}", _N) for i in range(1, 7)],
+    "robtarget": [("trans", "pos"), ("rot", "orient"), ("robconf", "confdata"), ("extax", "extjoint")],
+    "jointtarget": [("robax", "robjoint"), ("extax", "extjoint")],
+    "speeddata": [("v_tcp", _N), ("v_ori", _N), ("v_leax", _N), ("v_reax", _N)],
+    "zonedata": [("finep", BOOL), ("pzone_tcp", _N), ("pzone_ori", _N), ("pzone_eax", _N),
+                 ("zone_ori", _N), ("zone_leax", _N), ("zone_reax", _N)],
+    "loaddata": [("mass", _N), ("cog", "pos"), ("aom", "orient"), ("ix", _N), ("iy", _N), ("iz", _N)],
+    "tooldata": [("robhold", BOOL), ("tframe", "pose"), ("tload", "loaddata")],
+    "wobjdata": [("robhold", BOOL), ("ufprog", BOOL), ("ufmec", STRING), ("uframe", "pose"),
+                 ("oframe", "pose")],
+}
+KNOWN_TYPES = ATOMIC | set(RECORDS) | set(SIGNAL_TYPES)
+
+
+class Record:
+    """A value of a record type; components are kept by lower-case name, in declaration order."""
+
+    __slots__ = ("type", "fields")
+
+    def __init__(self, type_: str, fields: dict[str, object]):
+        self.type = type_
+        self.fields = fields
+
+    def copy(self) -> "Record":
+        return Record(self.type, {k: (v.copy() if isinstance(v, Record) else v) for k, v in self.fields.items()})
+
+    def values(self) -> list[object]:
+        return list(self.fields.values())
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Record) and self.type == other.type and self.fields == other.fields
+
+    def __repr__(self) -> str:
+        return format_value(self)
+
+
+class Aggregate(list):
+    """An untyped aggregate `[...]` before it is given a type."""
+
+
+@dataclass(frozen=True)
+class SignalRef:
+    """A configured I/O signal passed as an argument (not its value)."""
+
+    name: str  # as configured
+    kind: str  # DI, DO, AI, AO, GI, GO
+
+
+class TypeMismatch(Exception):
+    """Raised by `coerce`; the caller turns it into a positioned CheckError or ExecError."""
+
+
+def base_type(t: str) -> str:
+    return NUM if t in NUMERIC else t
+
+
+def default_value(t: str) -> object:
+    t = base_type(t)
+    if t == NUM:
+        return 0.0
+    if t == BOOL:
+        return False
+    if t == STRING:
+        return ""
+    if t in RECORDS:
+        return Record(t, {name: default_value(ft) for name, ft in RECORDS[t]})
+    raise TypeMismatch(f"no default value for type {t}")
+
+
+def type_of(v: object) -> str:
+    if isinstance(v, bool):
+        return BOOL
+    if isinstance(v, (int, float)):
+        return NUM
+    if isinstance(v, str):
+        return STRING
+    if isinstance(v, Record):
+        return v.type
+    if isinstance(v, SignalRef):
+        return SIGNAL_KINDS[v.kind]
+    if isinstance(v, Aggregate):
+        return "aggregate"
+    return type(v).__name__
+
+
+def coerce(v: object, t: str) -> object:
+    """`v` as a value of type `t` (aggregates become records); raises TypeMismatch."""
+    t = base_type(t)
+    if t == NUM:
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            return float(v)
+    elif t == BOOL:
+        if isinstance(v, bool):
+            return v
+    elif t == STRING:
+        if isinstance(v, str):
+            return v
+    elif t in RECORDS:
+        spec = RECORDS[t]
+        if isinstance(v, Record):
+            if v.type == t:
+                return v.copy()
+        elif isinstance(v, Aggregate):
+            if len(v) != len(spec):
+                raise TypeMismatch(f"a {t} has {len(spec)} components, the aggregate has {len(v)}")
+            out = {}
+            for (name, ft), item in zip(spec, v):
+                try:
+                    out[name] = coerce(item, ft)
+                except TypeMismatch as e:
+                    raise TypeMismatch(f"component {name} of the {t}: {e}") from None
+            return Record(t, out)
+    elif t in SIGNAL_TYPES:
+        if isinstance(v, SignalRef) and v.kind == SIGNAL_TYPES[t]:
+            return v
+    raise TypeMismatch(f"expected {t}, found {describe_type(v)}")
+
+
+def describe_type(v: object) -> str:
+    if isinstance(v, Aggregate):
+        return f"an aggregate of {len(v)} items"
+    return type_of(v)
+
+
+def fmt_num(x: float, digits: int = 6) -> str:
+    """A num as RAPID writes it: integers without a decimal point, others with up to 6 significant digits."""
+    if isinstance(x, bool):
+        return "TRUE" if x else "FALSE"
+    if math.isfinite(x) and x == int(x) and abs(x) < 1e15:
+        return str(int(x))
+    s = f"{x:.{digits}g}"
+    if "e" in s:
+        mant, exp = s.split("e")
+        s = f"{mant}E{int(exp):+03d}"
+    return s
+
+
+def format_value(v: object) -> str:
+    """A value as TPWrite / ValToStr show it."""
+    if isinstance(v, bool):
+        return "TRUE" if v else "FALSE"
+    if isinstance(v, (int, float)):
+        return fmt_num(v)
+    if isinstance(v, str):
+        return v
+    if isinstance(v, Record):
+        return "[" + ",".join(format_value(x) for x in v.values()) + "]"
+    if isinstance(v, (list, tuple)):
+        return "[" + ",".join(format_value(x) for x in v) + "]"
+    if isinstance(v, SignalRef):
+        return v.name
+    return str(v)
+
+
+def json_num(x: float) -> int | float:
+    """A num for JSON: integral values as integers (330, not 330.0)."""
+    if isinstance(x, bool):
+        return int(x)
+    if math.isfinite(x) and x == int(x) and abs(x) < 2 ** 53:
+        return int(x)
+    return round(float(x), 9)
+
+
+def to_plain(v: object) -> object:
+    """A value as plain JSON-able Python data (records as nested lists)."""
+    if isinstance(v, bool):
+        return v
+    if isinstance(v, (int, float)):
+        return json_num(v)
+    if isinstance(v, Record):
+        return [to_plain(x) for x in v.values()]
+    return v
+
+
+def record(t: str, *items: object) -> Record:
+    """Build a record from nested Python lists, e.g. record("pos", 1, 2, 3)."""
+    return coerce(Aggregate(_agg(x) for x in items), t)  # type: ignore[return-value]
+
+
+def _agg(x: object) -> object:
+    if isinstance(x, (list, tuple)):
+        return Aggregate(_agg(i) for i in x)
+    if isinstance(x, int) and not isinstance(x, bool):
+        return float(x)
+    return x
