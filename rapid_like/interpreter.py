@@ -177,7 +177,9 @@ class Interpreter:
 
     # ---- helpers --------------------------------------------------------------------------------
     def fail(self, message: str, span: Span | None, errname: str = "") -> ExecError:
-        return ExecError(message, span, B.ERRORS.get(errname, 0), errname)
+        """A runtime error; with an error name, ERROR handlers see it as ERRNO (e.g. ERR_DIVZERO)."""
+        text = f"{message} ({errname})" if errname else message
+        return ExecError(text, span, B.ERRORS.get(errname, 0), errname)
 
     def coerce(self, v: object, t: str, span: Span) -> object:
         try:
