@@ -1,0 +1,14 @@
+"""The PLC side of gripper-twin: a name-based Modbus/TCP client, the `plc` command, a scan-cycle virtual
+PLC and the thesis's grip sequence.
+
+    from plc_client import TwinClient, ScanCycle, ClientIO, GripSequence
+"""
+from .client import ClientIO, RegisterMap, Signal, TwinClient
+from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, PlcClientError,
+                     SignalValueError, UnknownSignalError, ValueOutOfRangeError)
+from .grip_sequence import Fault, GripSequence, Handshake, Phase
+from .scan import InputImage, ScanCycle, TwinIO
+
+__all__ = ["TwinClient", "RegisterMap", "Signal", "ClientIO", "ScanCycle", "InputImage", "TwinIO", "GripSequence",
+           "Handshake", "Phase", "Fault", "PlcClientError", "MapError", "UnknownSignalError", "SignalValueError",
+           "ValueOutOfRangeError", "NotWritableError", "ModbusExceptionError", "ConnectionFailedError"]

@@ -1,0 +1,198 @@
+"""The `plc` command: manual pokes at a running twin server, signals by name in engineering units.
+
+    plc [--host H] [--port P] [--unit-id U] (--map FILE.json | --station DIR) COMMAND
+        read NAME...                      one line per signal: name, value, unit
+        write NAME=VALUE...               checked first: one bad name or value and nothing is written
+        watch NAME... [--interval S] [--count N]   a live view (one redrawn line on a terminal)
+        map                               the signals it knows: table, address, type, unit, range, access
+
+The global options may also follow the command (`plc read L2 --port 5021`). Data goes to stdout; a
+problem is one line on stderr, `plc: error: ...`, with exit status 2 for a user error (unknown name, bad
+value, bad map) and 1 when the server cannot be reached or refuses a request.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .client import RegisterMap, Signal, TwinClient
+from .errors import ConnectionFailedError, ModbusExceptionError, PlcClientError, SignalValueError
+
+EXIT_USER, EXIT_CONNECTION = 2, 1
+TRUE, FALSE = ("1", "true", "on", "yes", "high"), ("0", "false", "off", "no", "low")
+
+
+def _globals(parser: argparse.ArgumentParser, suppress: bool) -> None:
+    d = (lambda v: argparse.SUPPRESS) if suppress else (lambda v: v)
+    g = parser.add_argument_group("connection and map")
+    g.add_argument("--host", default=d("127.0.0.1"), help="the twin server's host (default 127.0.0.1)")
+    g.add_argument("--port", type=int, default=d(5020), help="its Modbus/TCP port (default 5020)")
+    g.add_argument("--unit-id", type=int, default=d(1), help="the Modbus unit id (default 1)")
+    g.add_argument("--timeout", type=float, default=d(3.0), help="s to wait for an answer (default 3)")
+    m = g.add_mutually_exclusive_group()
+    m.add_argument("--map", metavar="FILE.json", default=d(None), help="the register map, from `twin map STATION --format json`")
+    m.add_argument("--station", metavar="DIR", default=d(None), help="build the register map from this station")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="plc", description="Read, write and watch a twin server's signals by name.")
+    _globals(parser, suppress=False)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    p = sub.add_parser("read", help="read signals: one line each, name value unit")
+    p.add_argument("names", nargs="+", metavar="NAME")
+    _globals(p, suppress=True)
+    p.set_defaults(func=cmd_read)
+    p = sub.add_parser("write", help="write signals in engineering units: NAME=VALUE (bools: 1/0, true/false, on/off)")
+    p.add_argument("assignments", nargs="+", metavar="NAME=VALUE")
+    _globals(p, suppress=True)
+    p.set_defaults(func=cmd_write)
+    p = sub.add_parser("watch", help="a live view of signals, sampled every --interval s")
+    p.add_argument("names", nargs="+", metavar="NAME")
+    p.add_argument("--interval", type=float, default=0.2, help="s between samples (default 0.2)")
+    p.add_argument("--count", type=int, default=None, help="stop after this many samples (default: until Ctrl-C)")
+    _globals(p, suppress=True)
+    p.set_defaults(func=cmd_watch)
+    p = sub.add_parser("map", help="the signals the map knows: table, address, type, unit, range, access")
+    _globals(p, suppress=True)
+    p.set_defaults(func=cmd_map)
+    return parser
+
+
+# -- commands ---------------------------------------------------------------------------------------------
+def load_map(args) -> RegisterMap:
+    if args.map:
+        return RegisterMap.from_json(args.map)
+    if args.station:
+        return RegisterMap.from_station(args.station)
+    raise UsageError("no register map: give --map FILE.json (from `twin map STATION --format json`) or --station DIR")
+
+
+def connect(args, rmap: RegisterMap) -> TwinClient:
+    return TwinClient.connect(args.host, args.port, args.unit_id, map=rmap, timeout=args.timeout)
+
+
+def cmd_read(args) -> int:
+    rmap = load_map(args)
+    signals = rmap.check_names(args.names)
+    with connect(args, rmap) as client:
+        values = client.read(*args.names)
+    rows = [(s.name, fmt(values[s.name]), s.unit) for s in signals]
+    print_rows(rows)
+    return 0
+
+
+def cmd_write(args) -> int:
+    rmap = load_map(args)
+    values = {}
+    for text in args.assignments:
+        name, sep, raw = text.partition("=")
+        if not sep or not name:
+            raise UsageError(f"{text!r}: write takes NAME=VALUE")
+        values[name.strip()] = parse_value(rmap[name.strip()], raw.strip())
+    for name, value in values.items():
+        rmap.check_value(name, value)
+    with connect(args, rmap) as client:
+        client.write(values)
+    print_rows([(n, fmt(v), rmap[n].unit) for n, v in values.items()])
+    return 0
+
+
+def cmd_watch(args) -> int:
+    rmap = load_map(args)
+    signals = rmap.check_names(args.names)
+    if args.interval <= 0:
+        raise UsageError("--interval must be greater than 0")
+    if args.count is not None and args.count < 1:
+        raise UsageError("--count must be at least 1")
+    tty = sys.stdout.isatty()
+    with connect(args, rmap) as client:
+        if not tty:
+            print("t_s  " + "  ".join(s.name + (f"[{s.unit}]" if s.unit else "") for s in signals), flush=True)
+        width = 0
+        try:
+            for t, values in client.poll(args.names, args.interval, args.count):
+                cells = [f"{s.name}={fmt(values[s.name])}{(' ' + s.unit) if s.unit else ''}" for s in signals]
+                if tty:
+                    line = f"t={t:7.2f}s  " + "  ".join(cells)
+                    sys.stdout.write("\r" + line.ljust(width))
+                    width = max(width, len(line))
+                else:
+                    sys.stdout.write(f"{t:.3f}  " + "  ".join(fmt(values[s.name]) for s in signals) + "\n")
+                sys.stdout.flush()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            if tty:
+                sys.stdout.write("\n")
+    return 0
+
+
+def cmd_map(args) -> int:
+    rmap = load_map(args)
+    rows = [("name", "table", "address", "type", "unit", "range", "access")]
+    for s in rmap:
+        rows.append((s.name, s.table, str(s.address) if s.count == 1 else f"{s.address}-{s.address + s.count - 1}",
+                     s.type, s.unit, s.range_text(), "rw" if s.writable else "r"))
+    print_rows(rows, header=True)
+    return 0
+
+
+# -- values and output -------------------------------------------------------------------------------------
+def parse_value(s: Signal, text: str):
+    """A command-line value for a signal: bools as 1/0, true/false, on/off; choices by text; else a number."""
+    low = text.lower()
+    if s.is_bool:
+        if low in TRUE:
+            return True
+        if low in FALSE:
+            return False
+        raise SignalValueError(s.name, f"needs 1 or 0 (true/false, on/off), not {text!r}")
+    if s.choices and text in s.choices:
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise SignalValueError(s.name, f"needs a number{' in ' + s.unit if s.unit else ''}, not {text!r}") from None
+    return int(value) if value.is_integer() and s.type != "float32" and s.scale == 1.0 and not s.unit else value
+
+
+def fmt(value) -> str:
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, float):
+        return f"{value:.3f}".rstrip("0").rstrip(".") if abs(value) < 1e6 else f"{value:.6g}"
+    if value == "":
+        return '""'
+    return str(value)
+
+
+def print_rows(rows, header: bool = False) -> None:
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    for i, row in enumerate(rows):
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        if header and i == 0:
+            print("  ".join("-" * w for w in widths))
+
+
+class UsageError(PlcClientError):
+    """A command line that cannot work (exit status 2)."""
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except (ConnectionFailedError, ModbusExceptionError) as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_CONNECTION
+    except PlcClientError as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_USER
+    except BrokenPipeError:  # `plc watch ... | head`
+        return 0
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,430 @@
+"""A name-based Modbus/TCP client for a twin server: read and write signals in engineering units.
+
+    from plc_client import TwinClient
+
+    with TwinClient.connect("127.0.0.1", 5020, map="ring_rig.json") as plc:   # or station="stations/ring_rig"
+        plc.write(L2=320.0)                    # mm, as the map publishes prismatic axes
+        plc.read("L2.actual", "L2.force", "doGripped")   # {'L2.actual': 329.9, 'L2.force': 3.1, 'doGripped': False}
+        for t, values in plc.poll(["L2.force"], interval=0.1, count=10): ...
+
+The register map comes from `twin map STATION --format json` output (a file) or from a station (built
+with the server's own `twin.modbus.register_map`, so both sides agree). A batch read groups signals at
+contiguous addresses of one table into one request. Values are checked against the map before anything
+is sent: an unknown name or an out-of-range value raises before the wire (see `plc_client.errors`).
+"""
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, PlcClientError,
+                     SignalValueError, UnknownSignalError, ValueOutOfRangeError)
+
+COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER = "coil", "discrete_input", "holding_register", "input_register"
+TABLES = (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)
+BIT_TABLES = (COIL, DISCRETE_INPUT)
+WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
+MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
+MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
+ADVANCE, STEP, TIME_MS = "sim.advance", "sim.step", "sim.time_ms"  # the lockstep registers
+
+
+@dataclass(frozen=True)
+class Signal:
+    """One entry of the register map."""
+
+    name: str
+    table: str
+    address: int  # 0-based protocol address
+    count: int = 1  # registers (or bits) it takes
+    type: str = "uint16"  # bool, uint16, int16, uint32, int32, float32
+    scale: float = 1.0  # engineering units per count
+    unit: str = ""
+    min: float | None = None
+    max: float | None = None
+    access: str = "r"
+    description: str = ""
+    choices: tuple[str, ...] = ()  # an enumeration: the value is the index into these
+
+    @property
+    def writable(self) -> bool:
+        return self.table in WRITABLE_TABLES and "w" in self.access
+
+    @property
+    def is_bool(self) -> bool:
+        return self.type == "bool" or self.table in BIT_TABLES
+
+    def range_text(self) -> str:
+        if self.is_bool:
+            return "0/1"
+        if self.choices:
+            return "|".join(c or '""' for c in self.choices)
+        lo = "" if self.min is None else f"{self.min:g}"
+        hi = "" if self.max is None else f"{self.max:g}"
+        return f"{lo}..{hi}" if (lo or hi) else ""
+
+
+class RegisterMap:
+    """The signals by name, as published by the server."""
+
+    def __init__(self, signals: Iterable[Signal], meta: Mapping[str, Any] | None = None):
+        self.signals: dict[str, Signal] = {}
+        for s in signals:
+            if s.table not in TABLES:
+                raise MapError(f"signal {s.name!r}: unknown table {s.table!r} (one of {', '.join(TABLES)})")
+            self.signals[s.name] = s
+        self.meta = dict(meta or {})
+
+    # -- loading ------------------------------------------------------------------------------------
+    @classmethod
+    def from_json(cls, source: str | Path | Mapping | list) -> "RegisterMap":
+        """From `twin map --format json` output: a file path, its text, or the parsed data."""
+        where = "register map"
+        if isinstance(source, Path) or (isinstance(source, str) and not source.lstrip().startswith(("{", "["))):
+            where = str(source)
+            try:
+                source = Path(source).read_text(encoding="utf-8")
+            except OSError as exc:
+                raise MapError(f"{where}: cannot read the register map: {exc.strerror or exc}") from None
+        if isinstance(source, str):
+            try:
+                source = json.loads(source)
+            except json.JSONDecodeError as exc:
+                raise MapError(f"{where}: not JSON (line {exc.lineno}: {exc.msg}); "
+                               f"make one with `twin map STATION --format json`") from None
+        data = source
+        meta: dict = {}
+        if isinstance(data, Mapping):
+            meta = {k: v for k, v in data.items() if k not in ("signals", "entries", "registers")}
+            data = data.get("signals", data.get("entries", data.get("registers")))
+        if not isinstance(data, list):
+            raise MapError(f"{where}: expected a list of signals (the output of `twin map STATION --format json`)")
+        return cls((_signal_from_dict(e, where, i) for i, e in enumerate(data)), meta)
+
+    @classmethod
+    def from_station(cls, station: str | Path) -> "RegisterMap":
+        """Build the map the server would serve for this station (with the server's own map builder)."""
+        try:
+            from twin.modbus import register_map as rm
+        except ImportError as exc:  # pragma: no cover - the server side is part of this project
+            raise MapError(f"cannot build the map of a station here ({exc}); use `twin map STATION --format json` "
+                           "and --map FILE") from None
+        from twin.core.errors import TwinError
+
+        try:
+            built = rm.build_map(station) if hasattr(rm, "build_map") else rm.RegisterMap.from_station(station)
+            data = built.to_json() if hasattr(built, "to_json") else built.as_dict()
+        except TwinError as exc:
+            raise MapError(str(exc)) from None
+        return cls.from_json(data if not isinstance(data, str) else json.loads(data))
+
+    # -- lookup -------------------------------------------------------------------------------------
+    def __getitem__(self, name: str) -> Signal:
+        try:
+            return self.signals[name]
+        except KeyError:
+            raise UnknownSignalError(name, self.signals) from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.signals
+
+    def __iter__(self) -> Iterator[Signal]:
+        return iter(self.signals.values())
+
+    def __len__(self) -> int:
+        return len(self.signals)
+
+    def check_names(self, names: Iterable[str]) -> list[Signal]:
+        return [self[n] for n in names]
+
+    # -- values -------------------------------------------------------------------------------------
+    def check_value(self, name: str, value: Any) -> Any:
+        """The value in engineering units, checked against the map (not yet encoded)."""
+        s = self[name]
+        if not s.writable:
+            raise NotWritableError(name)
+        return _check(s, value)
+
+
+def _signal_from_dict(e: Any, where: str, i: int) -> Signal:
+    if not isinstance(e, Mapping) or "name" not in e or "table" not in e or "address" not in e:
+        raise MapError(f"{where}: entry {i} needs at least name, table and address")
+    try:
+        return Signal(name=str(e["name"]), table=str(e["table"]), address=int(e["address"]), count=int(e.get("count", 1)),
+                      type=str(e.get("type", "bool" if e["table"] in BIT_TABLES else "uint16")),
+                      scale=float(e.get("scale") or 1.0), unit=str(e.get("unit") or ""),
+                      min=None if e.get("min") is None else float(e["min"]),
+                      max=None if e.get("max") is None else float(e["max"]),
+                      access=str(e.get("access") or ("rw" if e["table"] in WRITABLE_TABLES else "r")),
+                      description=str(e.get("description") or ""), choices=tuple(e.get("choices") or ()))
+    except (TypeError, ValueError) as exc:
+        raise MapError(f"{where}: entry {i} ({e.get('name')!r}): {exc}") from None
+
+
+def _check(s: Signal, value: Any) -> Any:
+    if s.is_bool:
+        if isinstance(value, bool) or value in (0, 1):
+            return bool(value)
+        raise SignalValueError(s.name, f"needs true or false (1 or 0), not {value!r}")
+    if s.choices and isinstance(value, str):
+        if value not in s.choices:
+            raise SignalValueError(s.name, f"{value!r} is not one of {', '.join(repr(c) for c in s.choices)}")
+        return s.choices.index(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+        raise SignalValueError(s.name, f"needs a number, not {value!r}")
+    if (s.min is not None and value < s.min) or (s.max is not None and value > s.max):
+        raise ValueOutOfRangeError(s.name, value, s.min, s.max, s.unit)
+    return value
+
+
+# -- encode / decode (register words, big-endian, high word first) --------------------------------------
+_WIDTH = {"uint16": 1, "int16": 1, "uint32": 2, "int32": 2, "float32": 2}
+
+
+def encode(s: Signal, value: Any) -> list[int] | list[bool]:
+    """Engineering value -> register words (or one bit)."""
+    if s.table in BIT_TABLES:
+        return [bool(value)]
+    if s.type == "bool":
+        return [1 if value else 0]
+    import struct
+
+    if s.type == "float32":
+        raw = struct.unpack(">HH", struct.pack(">f", float(value) / s.scale))
+        return list(raw)
+    count = round(float(value) / s.scale)
+    fmt = {"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i"}[s.type]
+    try:
+        packed = struct.pack(fmt, count)
+    except struct.error:
+        raise ValueOutOfRangeError(s.name, value, None, None, s.unit) from None
+    return list(struct.unpack(">" + "H" * (len(packed) // 2), packed))
+
+
+def decode(s: Signal, words: list) -> Any:
+    """Register words (or bits) -> engineering value (bool, float, int, or the enumeration's text)."""
+    if s.table in BIT_TABLES:
+        return bool(words[0])
+    if s.type == "bool":
+        return bool(words[0])
+    import struct
+
+    data = struct.pack(">" + "H" * len(words), *words)
+    if s.type == "float32":
+        return struct.unpack(">f", data)[0] * s.scale
+    raw = struct.unpack({"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i"}[s.type], data)[0]
+    if s.choices:
+        return s.choices[raw] if 0 <= raw < len(s.choices) else raw
+    return raw if s.scale == 1.0 and not s.unit else raw * s.scale
+
+
+@dataclass
+class _Run:
+    table: str
+    start: int
+    end: int  # exclusive
+    signals: list[Signal] = field(default_factory=list)
+
+
+def plan_reads(signals: Iterable[Signal]) -> list[_Run]:
+    """Group signals into requests: contiguous addresses of one table, within the protocol's size limits."""
+    runs: list[_Run] = []
+    for s in sorted(set(signals), key=lambda s: (TABLES.index(s.table), s.address)):
+        limit = MAX_BITS if s.table in BIT_TABLES else MAX_REGISTERS
+        last = runs[-1] if runs else None
+        if last and last.table == s.table and s.address <= last.end and max(last.end, s.address + s.count) - last.start <= limit:
+            last.end = max(last.end, s.address + s.count)
+            last.signals.append(s)
+        else:
+            runs.append(_Run(s.table, s.address, s.address + s.count, [s]))
+    return runs
+
+
+class TwinClient:
+    """A connection to a twin server, signals by name (see the module's docstring)."""
+
+    def __init__(self, register_map: RegisterMap, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1,
+                 timeout: float = 3.0):
+        self.map, self.host, self.port, self.unit_id, self.timeout = register_map, host, int(port), int(unit_id), timeout
+        self._client = None
+        self.requests = 0  # requests sent, for tests and diagnostics
+
+    @classmethod
+    def connect(cls, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1, *, map: str | Path | RegisterMap | None = None,
+                station: str | Path | None = None, timeout: float = 3.0) -> "TwinClient":
+        """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`."""
+        if isinstance(map, RegisterMap):
+            rmap = map
+        elif map is not None:
+            rmap = RegisterMap.from_json(map)
+        elif station is not None:
+            rmap = RegisterMap.from_station(station)
+        else:
+            raise MapError("no register map: give map=FILE.json (from `twin map STATION --format json`) or station=DIR")
+        client = cls(rmap, host, port, unit_id, timeout)
+        client.open()
+        return client
+
+    def open(self) -> None:
+        from pymodbus.client import ModbusTcpClient
+
+        self._client = ModbusTcpClient(self.host, port=self.port, timeout=self.timeout, retries=0)
+        try:
+            ok = self._client.connect()
+        except Exception as exc:  # pymodbus wraps socket errors differently across versions
+            raise ConnectionFailedError(self.host, self.port, str(exc)) from None
+        if not ok:
+            self._client = None
+            raise ConnectionFailedError(self.host, self.port, "connection refused or timed out")
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+    def __enter__(self) -> "TwinClient":
+        if self._client is None:
+            self.open()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- the wire -----------------------------------------------------------------------------------
+    def _call(self, function: int, method: str, address: int, count: int, signals: Iterable[Signal], *args, **kw):
+        if self._client is None:
+            raise ConnectionFailedError(self.host, self.port, "not connected")
+        from pymodbus.exceptions import ModbusException
+
+        self.requests += 1
+        try:
+            response = getattr(self._client, method)(address, *args, device_id=self.unit_id, **kw)
+        except ModbusException as exc:
+            raise ConnectionFailedError(self.host, self.port, str(exc).strip() or type(exc).__name__) from None
+        except OSError as exc:
+            raise ConnectionFailedError(self.host, self.port, exc.strerror or str(exc)) from None
+        if response.isError():
+            code = getattr(response, "exception_code", 0)
+            raise ModbusExceptionError(code, function, address, count, self.unit_id, (s.name for s in signals))
+        return response
+
+    def read_signals(self, signals: Iterable[Signal]) -> dict[str, Any]:
+        values: dict[str, Any] = {}
+        for run in plan_reads(signals):
+            n = run.end - run.start
+            fc, method = {COIL: (1, "read_coils"), DISCRETE_INPUT: (2, "read_discrete_inputs"),
+                          HOLDING_REGISTER: (3, "read_holding_registers"), INPUT_REGISTER: (4, "read_input_registers")}[run.table]
+            r = self._call(fc, method, run.start, n, run.signals, count=n)
+            words = r.bits if run.table in BIT_TABLES else r.registers
+            for s in run.signals:
+                off = s.address - run.start
+                values[s.name] = decode(s, list(words[off:off + s.count]))
+        return values
+
+    # -- by name ------------------------------------------------------------------------------------
+    def read(self, *names: str) -> dict[str, Any]:
+        """Values by name, in engineering units, in the order asked. Unknown names raise before any request."""
+        if len(names) == 1 and not isinstance(names[0], str):
+            names = tuple(names[0])
+        signals = self.map.check_names(names)
+        values = self.read_signals(signals)
+        return {n: values[n] for n in names}
+
+    def get(self, name: str) -> Any:
+        return self.read(name)[name]
+
+    def write(self, values: Mapping[str, Any] | None = None, /, **more: Any) -> None:
+        """Write signals by name (`write(L2=320.0)` or `write({"L2.x": 1})`). Everything is checked first:
+        one bad name or value and nothing is written. Contiguous registers go in one request."""
+        items = dict(values or {}, **more)
+        checked = [(self.map[n], self.map.check_value(n, v)) for n, v in items.items()]
+        by_table: dict[str, list[tuple[Signal, list]]] = {}
+        for s, v in sorted(checked, key=lambda sv: (sv[0].table, sv[0].address)):
+            by_table.setdefault(s.table, []).append((s, encode(s, v)))
+        for table, entries in by_table.items():
+            limit = MAX_WRITE_BITS if table == COIL else MAX_WRITE_REGISTERS
+            run: list[tuple[Signal, list]] = []
+            for s, words in entries:
+                if run and (s.address != run[-1][0].address + run[-1][0].count or
+                            s.address + s.count - run[0][0].address > limit):
+                    self._write_run(table, run)
+                    run = []
+                run.append((s, words))
+            if run:
+                self._write_run(table, run)
+
+    def _write_run(self, table: str, run: list[tuple[Signal, list]]) -> None:
+        start = run[0][0].address
+        words = [w for _, ws in run for w in ws]
+        if table == COIL:
+            self._call(15, "write_coils", start, len(words), [s for s, _ in run], words)
+        else:
+            self._call(16, "write_registers", start, len(words), [s for s, _ in run], words)
+
+    def poll(self, names: Iterable[str], interval: float = 0.1, count: int | None = None) -> Iterator[tuple[float, dict]]:
+        """Read `names` every `interval` s (against the wall clock): yields (s since the first read, values).
+        Endless unless `count` is given: stop by breaking out of the loop."""
+        names = list(names)
+        self.map.check_names(names)
+        t0 = time.monotonic()
+        n = 0
+        while count is None or n < count:
+            yield time.monotonic() - t0, self.read(*names)
+            n += 1
+            if count is not None and n >= count:
+                break
+            delay = t0 + n * interval - time.monotonic()
+            if delay > 0:
+                time.sleep(delay)
+
+    # -- lockstep -----------------------------------------------------------------------------------
+    @property
+    def lockstep_capable(self) -> bool:
+        return ADVANCE in self.map
+
+    def advance(self, steps: int, timeout: float = 30.0) -> None:
+        """Lockstep: run `steps` simulation steps on the server and wait until they are done."""
+        if steps <= 0:
+            return
+        self.write({ADVANCE: steps})
+        end = time.monotonic() + timeout
+        delay = 0.0002
+        while self.get(ADVANCE) != 0:
+            if time.monotonic() > end:
+                raise PlcClientError(f"the server did not finish {steps} steps within {timeout:g} s "
+                                     "(is it serving in lockstep mode?)")
+            time.sleep(delay)
+            delay = min(delay * 2, 0.005)
+
+
+class ClientIO:
+    """The network side of a scan cycle: `ScanCycle(ClientIO(client), logic)`.
+
+    Lockstep (the server was started with `--lockstep`): each scan runs `cycle / dt` steps through
+    `sim.advance` (carried over, so the average matches); otherwise the scan cycle paces itself against the
+    wall clock and the server runs in real time.
+    """
+
+    def __init__(self, client: TwinClient, *, lockstep: bool | None = None, dt: float | None = None):
+        self.client = client
+        self.lockstep = client.lockstep_capable if lockstep is None else lockstep
+        self.dt = dt or float(client.map.meta.get("step", client.map.meta.get("dt", 0.012)))
+        self._time, self._steps = 0.0, 0
+
+    def read_image(self, names: Iterable[str]) -> dict[str, Any]:
+        return self.client.read(*names)
+
+    def write_image(self, values: Mapping[str, Any]) -> None:
+        self.client.write(values)
+
+    def advance(self, seconds: float) -> None:
+        self._time += seconds
+        target = math.floor(self._time / self.dt + 1e-9)
+        if target > self._steps:
+            self.client.advance(target - self._steps)
+            self._steps = target

@@ -1,0 +1,91 @@
+"""Errors of the PLC client. Raised where the problem is found; the CLI shows them once, as one line.
+
+    PlcClientError                 base of everything the client raises on purpose
+    ├── MapError                   the register map cannot be loaded (names the file)
+    ├── UnknownSignalError         a name the map does not have ("did you mean ...?")
+    ├── SignalValueError           a value a signal cannot take
+    │   ├── ValueOutOfRangeError   outside the signal's range (names signal, value and range)
+    │   └── NotWritableError       the signal is an output of the twin
+    ├── ModbusExceptionError       the server answered with a Modbus exception (code, address, unit)
+    └── ConnectionFailedError      no server at host:port, or the connection broke
+"""
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+
+# Modbus exception codes (the application protocol specification, section 7)
+EXCEPTION_NAMES = {1: "illegal function", 2: "illegal data address", 3: "illegal data value",
+                   4: "server device failure", 5: "acknowledge", 6: "server device busy",
+                   8: "memory parity error", 10: "gateway path unavailable", 11: "gateway target failed to respond"}
+
+
+class PlcClientError(Exception):
+    """Base class of the PLC client's errors."""
+
+
+class MapError(PlcClientError):
+    """A register map file or station cannot be read."""
+
+
+class UnknownSignalError(PlcClientError, KeyError):
+    """A signal name that is not in the register map."""
+
+    def __init__(self, name: str, known: Iterable[str] = ()):
+        self.signal = name
+        self.suggestions = tuple(difflib.get_close_matches(name, list(known), n=3, cutoff=0.6))
+        hint = f"; did you mean {' or '.join(repr(s) for s in self.suggestions)}?" if self.suggestions else \
+            " (`plc map` lists the signals)"
+        super().__init__(f"unknown signal {name!r}{hint}")
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return self.args[0]
+
+
+class SignalValueError(PlcClientError, ValueError):
+    """A value a signal cannot take."""
+
+    def __init__(self, name: str, message: str):
+        self.signal = name
+        super().__init__(f"signal {name!r}: {message}")
+
+
+class ValueOutOfRangeError(SignalValueError):
+    """A value outside the signal's range (never clamped)."""
+
+    def __init__(self, name: str, value: float, lo: float | None, hi: float | None, unit: str = ""):
+        self.value, self.min, self.max, self.unit = value, lo, hi, unit
+        u = f" {unit}" if unit else ""
+        rng = f"{_g(lo)} to {_g(hi)}{u}" if lo is not None and hi is not None else \
+            (f"at least {_g(lo)}{u}" if lo is not None else f"at most {_g(hi)}{u}")
+        super().__init__(name, f"{_g(value)}{u} is out of range: {rng}")
+
+
+class NotWritableError(SignalValueError):
+    """A write to a signal the twin computes (an output)."""
+
+    def __init__(self, name: str):
+        super().__init__(name, "is an output of the twin and cannot be written")
+
+
+class ModbusExceptionError(PlcClientError):
+    """The server answered a request with a Modbus exception."""
+
+    def __init__(self, code: int, function: int, address: int, count: int, unit: int, signals: Iterable[str] = ()):
+        self.code, self.function, self.address, self.count, self.unit = code, function, address, count, unit
+        self.signals = tuple(signals)
+        what = f" ({', '.join(self.signals)})" if self.signals else ""
+        super().__init__(f"Modbus exception {code:02d} ({EXCEPTION_NAMES.get(code, 'unknown')}) for function "
+                         f"{function:#04x} at address {address}, count {count}, unit {unit}{what}")
+
+
+class ConnectionFailedError(PlcClientError):
+    """No server answered at host:port, or the connection broke."""
+
+    def __init__(self, host: str, port: int, message: str = "no answer"):
+        self.host, self.port = host, port
+        super().__init__(f"cannot reach a twin server at {host}:{port}: {message}")
+
+
+def _g(v) -> str:
+    return f"{v:g}" if isinstance(v, (int, float)) else str(v)

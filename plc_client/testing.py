@@ -1,0 +1,201 @@
+"""Scripted commissioning checks: a twin server for a station on a free loopback port, and a client to it.
+
+As a context manager, anywhere:
+
+    from plc_client.testing import twin_server
+
+    with twin_server("stations/ring_rig", lockstep=True) as server:
+        with server.client() as plc:
+            plc.write(L2=320.0); plc.advance(100); assert plc.get("L2.actual") < 330.0
+
+As pytest fixtures (in your `conftest.py`: `pytest_plugins = ["plc_client.testing"]`, and name the station):
+
+    @pytest.fixture
+    def plc_station():
+        return "stations/ring_rig"
+
+    def test_fingers_close(twin_client):          # a connected TwinClient; the server is lockstep
+        twin_client.write(L2=320.0)
+        twin_client.advance(100)
+        assert twin_client.get("L2.actual") == pytest.approx(320.0, abs=0.5)
+
+`plc_server` gives the running server (`.host`, `.port`, `.map`, `.client()`), `plc_lockstep` (default
+True) chooses lockstep or real time. See docs/commissioning-checks.md.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from .client import ClientIO, RegisterMap, TwinClient
+from .errors import PlcClientError
+
+LOOPBACK = "127.0.0.1"
+
+
+class ServerStartError(PlcClientError):
+    """`twin serve` did not come up (its stderr is in the message)."""
+
+
+@dataclass
+class TwinServer:
+    """A running `twin serve` subprocess."""
+
+    station: Path
+    host: str
+    port: int
+    unit_id: int
+    lockstep: bool
+    map: RegisterMap
+    process: subprocess.Popen
+
+    def client(self, timeout: float = 3.0) -> TwinClient:
+        """A new connected client (close it, or use it in a `with`)."""
+        return TwinClient.connect(self.host, self.port, self.unit_id, map=self.map, timeout=timeout)
+
+    def io(self, client: TwinClient) -> ClientIO:
+        """The scan-cycle I/O for `client`: lockstep when the server is."""
+        return ClientIO(client, lockstep=self.lockstep)
+
+    def plc_args(self) -> list[str]:
+        """The global options of the `plc` command for this server (with a map file written once)."""
+        return ["--host", self.host, "--port", str(self.port), "--unit-id", str(self.unit_id), "--map", str(self.map_file)]
+
+    @property
+    def map_file(self) -> Path:
+        path = getattr(self, "_map_file", None)
+        if path is None:
+            fd, name = tempfile.mkstemp(prefix=f"twin-map-{self.port}-", suffix=".json")
+            with os.fdopen(fd, "w") as f:
+                f.write(self.map_json)
+            path = self._map_file = Path(name)
+        return path
+
+    map_json: str = ""
+
+    @property
+    def running(self) -> bool:
+        return self.process.poll() is None
+
+
+def free_port(host: str = LOOPBACK) -> int:
+    """A port the OS has just handed out (bound to port 0, then released)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind((host, 0))
+        return s.getsockname()[1]
+
+
+def twin_command() -> list[str]:
+    return [sys.executable, "-m", "twin"]
+
+
+def station_map_json(station: str | Path) -> str:
+    """`twin map STATION --format json`, as a user would run it."""
+    r = subprocess.run([*twin_command(), "map", str(station), "--format", "json"], capture_output=True, text=True,
+                       timeout=60)
+    if r.returncode != 0:
+        raise ServerStartError(f"`twin map {station} --format json` failed ({r.returncode}): {r.stderr.strip()}")
+    return r.stdout
+
+
+@contextlib.contextmanager
+def twin_server(station: str | Path, *, lockstep: bool = True, speed: float | None = None, host: str = LOOPBACK,
+                port: int | None = None, unit_id: int = 1, startup_timeout: float = 30.0,
+                extra_args: list[str] = ()) -> Iterator[TwinServer]:
+    """Start `twin serve STATION` on a free loopback port, wait until it accepts connections, stop it after.
+
+    lockstep: the server only steps when told (`sim.advance`): the same run gives the same result. Else it
+    runs in real time, or at `speed` times real time.
+    """
+    station = Path(station)
+    map_json = station_map_json(station)
+    rmap = RegisterMap.from_json(map_json)
+    mode = ["--lockstep"] if lockstep else (["--speed", f"{speed:g}"] if speed else ["--realtime"])
+    attempts = 1 if port else 3
+    last_error = ""
+    for _ in range(attempts):
+        p = port or free_port(host)
+        with tempfile.TemporaryFile(mode="w+") as err:
+            proc = subprocess.Popen([*twin_command(), "serve", str(station), "--host", host, "--port", str(p),
+                                     "--unit-id", str(unit_id), *mode, *extra_args],
+                                    stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err)
+            try:
+                if _wait_listening(proc, host, p, startup_timeout):
+                    server = TwinServer(station, host, p, unit_id, lockstep, rmap, proc, map_json=map_json)
+                    try:
+                        yield server
+                    finally:
+                        _stop(proc)
+                        mf = getattr(server, "_map_file", None)
+                        if mf is not None:
+                            mf.unlink(missing_ok=True)
+                    return
+                _stop(proc)
+                err.seek(0)
+                last_error = err.read().strip()[-2000:]
+            except BaseException:
+                _stop(proc)
+                raise
+    raise ServerStartError(f"`twin serve {station}` did not start on {host}: {last_error or 'no output'}")
+
+
+def _wait_listening(proc: subprocess.Popen, host: str, port: int, timeout: float) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if proc.poll() is not None:
+            return False
+        try:
+            with socket.create_connection((host, port), timeout=0.2):
+                return True
+        except OSError:
+            time.sleep(0.05)
+    return False
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout=5)
+
+
+# -- pytest fixtures (load with `pytest_plugins = ["plc_client.testing"]`) ---------------------------------
+try:
+    import pytest
+except ImportError:  # pragma: no cover - the fixtures need pytest, the context manager does not
+    pytest = None
+
+if pytest is not None:
+
+    @pytest.fixture
+    def plc_lockstep() -> bool:
+        """Override to run the server in real time (False)."""
+        return True
+
+    @pytest.fixture
+    def plc_station():
+        """Override with the station (folder or station.toml) the checks run against."""
+        pytest.fail("define a `plc_station` fixture returning the station to serve (see docs/commissioning-checks.md)")
+
+    @pytest.fixture
+    def plc_server(plc_station, plc_lockstep) -> Iterator[TwinServer]:
+        """A `twin serve` of `plc_station` on a free loopback port, stopped after the test."""
+        with twin_server(plc_station, lockstep=plc_lockstep) as server:
+            yield server
+
+    @pytest.fixture
+    def twin_client(plc_server) -> Iterator[TwinClient]:
+        """A TwinClient connected to `plc_server`."""
+        with plc_server.client() as client:
+            yield client
