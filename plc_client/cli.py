@@ -4,6 +4,7 @@
         read NAME...                      one line per signal: name, value, unit
         write NAME=VALUE...               checked first: one bad name or value and nothing is written
         watch NAME... [--interval S] [--count N]   a live view (one redrawn line on a terminal)
+        run MODULE:NAME [--cycle S] [--seconds S]  run PLC logic (e.g. plc_client.ring_rig:sequence)
         map                               the signals it knows: table, address, type, unit, range, access
 
 The global options may also follow the command (`plc read L2 --port 5021`). Data goes to stdout; a
@@ -52,6 +53,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--count", type=int, default=None, help="stop after this many samples (default: until Ctrl-C)")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_watch)
+    p = sub.add_parser("run", help="run PLC logic (module:name or file.py:name) on a scan cycle against the server")
+    p.add_argument("target", metavar="MODULE:NAME", help="a logic with .inputs (e.g. a GripSequence), or a function "
+                   "without arguments that returns one, e.g. plc_client.ring_rig:sequence")
+    p.add_argument("--cycle", type=float, default=0.010, help="scan cycle, s (default 0.010)")
+    bound = p.add_mutually_exclusive_group()
+    bound.add_argument("--seconds", type=float, default=None, help="stop after this much PLC time")
+    bound.add_argument("--scans", type=int, default=None, help="stop after this many scans")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--lockstep", dest="lockstep", action="store_true", default=None,
+                      help="the server was started with --lockstep: each scan advances it one cycle (default: when the map has sim.advance)")
+    mode.add_argument("--realtime", dest="lockstep", action="store_false", help="pace the scans against the wall clock")
+    p.add_argument("--quiet", action="store_true", help="do not print the outputs' changes")
+    _globals(p, suppress=True)
+    p.set_defaults(func=cmd_run)
     p = sub.add_parser("map", help="the signals the map knows: table, address, type, unit, range, access")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_map)
@@ -124,6 +139,68 @@ def cmd_watch(args) -> int:
         finally:
             if tty:
                 sys.stdout.write("\n")
+    return 0
+
+
+def load_logic(target: str):
+    """`package.module:name` or `path/to/file.py:name`: a logic object, or a factory returning one."""
+    import importlib
+    import importlib.util
+
+    where, sep, attr = target.rpartition(":")
+    if not sep or not where or not attr:
+        raise UsageError(f"{target!r}: give MODULE:NAME or FILE.py:NAME")
+    try:
+        if where.endswith(".py"):
+            spec = importlib.util.spec_from_file_location("plc_user_logic", where)
+            if spec is None or not spec.loader:
+                raise UsageError(f"{where}: cannot load this file")
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+        else:
+            module = importlib.import_module(where)
+    except (ImportError, OSError) as exc:
+        raise UsageError(f"{where}: cannot import: {exc}") from None
+    obj = getattr(module, attr, None)
+    if obj is None:
+        raise UsageError(f"{where} has no {attr!r}")
+    if not hasattr(obj, "inputs") and callable(obj):
+        obj = obj()
+    if not callable(obj) or not hasattr(obj, "inputs"):
+        raise UsageError(f"{target}: not a PLC logic (a callable with .inputs, e.g. a GripSequence or an @plc_logic function)")
+    return obj
+
+
+def cmd_run(args) -> int:
+    from .client import ClientIO
+    from .scan import ScanCycle
+
+    logic = load_logic(args.target)
+    rmap = load_map(args)
+    rmap.check_names(logic.inputs)
+    for name in getattr(logic, "outputs", ()):
+        rmap[name]
+    if args.cycle <= 0:
+        raise UsageError("--cycle must be greater than 0")
+    with connect(args, rmap) as client:
+        plc = ScanCycle(ClientIO(client, lockstep=args.lockstep), logic, cycle=args.cycle)
+        print(f"plc: {args.target} every {args.cycle * 1000:g} ms, "
+              f"{'lockstep' if not plc.realtime else 'real time'}, against {args.host}:{args.port}",
+              file=sys.stderr, flush=True)
+        end = None if args.seconds is None else args.seconds - 1e-9
+        try:
+            while (args.scans is None or plc.scans < args.scans) and (end is None or plc.time < end):
+                before = dict(plc.written)
+                plc.scan()
+                if not args.quiet:
+                    changed = [(k, v) for k, v in plc.written.items()
+                               if not isinstance(v, float) and before.get(k, None) != v]
+                    if changed:
+                        print(f"t={plc.time:8.3f}  " + "  ".join(f"{k}={fmt(v)}" for k, v in changed), flush=True)
+        except KeyboardInterrupt:
+            pass
+    if plc.realtime and plc.overruns:
+        print(f"plc: {plc.overruns} of {plc.scans} scans overran the {args.cycle * 1000:g} ms cycle", file=sys.stderr)
     return 0
 
 

@@ -63,6 +63,21 @@ class InputImage(Mapping):
 Logic = Callable[[InputImage, Any], Mapping[str, Any]]
 
 
+def plc_logic(inputs: Iterable[str], state: Callable[[], Any] | None = None):
+    """Declare what a plain logic function reads (and how its state starts), for `ScanCycle` and `plc run`:
+
+        @plc_logic(inputs=["start", "L2.force"])
+        def press(inputs, state):
+            return {"L2": 300.0 if inputs["start"] else 330.0}
+    """
+    def mark(fn):
+        fn.inputs = tuple(inputs)
+        if state is not None:
+            fn.initial_state = state
+        return fn
+    return mark
+
+
 class ScanCycle:
     """A virtual PLC: `io` is the process, `logic(inputs, state)` the program, `cycle` the scan time (s).
 

@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pytest
 
-from plc_client.grip_sequence import GripSequence
+from plc_client import ring_rig
 from plc_client.scan import ScanCycle, TwinIO
 from tests.conftest import STATIONS  # noqa: F401  (re-exported for the tests here)
 from twin.core import Twin
@@ -16,12 +16,7 @@ RING_FORCES = ("L2.force", "L3.force", "L5.force")
 
 def ring_sequence(**overrides) -> GripSequence:
     """The ring rig's grip sequence (mm, N): outside grips touch at 320 mm, inside grips at 200 mm."""
-    params = dict(axes=("L2", "L3", "L4"), forces=RING_FORCES, speed=20.0, threshold=200.0,
-                  end_of_travel={"outside": 290.0, "inside": 230.0},
-                  contacts=("L2.contact", "L3.contact", "L5.contact"),
-                  ready_position={"outside": 330.0, "inside": 150.0})
-    params.update(overrides)
-    return GripSequence(**params)
+    return ring_rig.sequence(**overrides)
 
 
 class Bench:

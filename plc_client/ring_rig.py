@@ -1,0 +1,28 @@
+"""The ring rig's gripper PLC (thesis section 3.1): the grip sequence with the rig's numbers, in mm and N.
+
+Fingers (axes L2, L3, L4; finger forces L2, L3 and L5, the fine axis on finger 3) close from outside onto
+the ring's 320 mm outer radius, or open from inside into its 240 mm bore (finger outer faces at setpoint
++ 40 mm, so touching at 200 mm). A grip that reaches 290 mm (outside) or 230 mm (inside) without force
+has missed the ring. A release opens at least back to where the next grip of the same kind starts
+(330 mm outside, 150 mm inside).
+
+    python -m plc_client --port 5020 --station stations/ring_rig_plc run plc_client.ring_rig:sequence
+"""
+from __future__ import annotations
+
+from .grip_sequence import GripSequence, Handshake
+
+AXES = ("L2", "L3", "L4")
+FORCES = ("L2.force", "L3.force", "L5.force")
+CONTACTS = ("L2.contact", "L3.contact", "L5.contact")
+
+
+def sequence(handshake: Handshake | None = None, **overrides) -> GripSequence:
+    """The ring rig's grip sequence; any `GripSequence` parameter can be overridden."""
+    params = dict(axes=AXES, forces=FORCES, contacts=CONTACTS, speed=20.0, threshold=200.0,
+                  end_of_travel={"outside": 290.0, "inside": 230.0},
+                  ready_position={"outside": 330.0, "inside": 150.0},
+                  release_limit={"outside": 441.0, "inside": 0.0},
+                  handshake=handshake or Handshake())
+    params.update(overrides)
+    return GripSequence(**params)
