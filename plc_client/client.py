@@ -216,11 +216,21 @@ def decode(s: Signal, words: list) -> Any:
 
     data = struct.pack(">" + "H" * len(words), *words)
     if s.type == "float32":
-        return struct.unpack(">f", data)[0] * s.scale
+        return _scaled(struct.unpack(">f", data)[0], s.scale)
     raw = struct.unpack({"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i"}[s.type], data)[0]
     if s.choices:
         return s.choices[raw] if 0 <= raw < len(s.choices) else raw
-    return raw if s.scale == 1.0 and not s.unit else raw * s.scale
+    return raw if s.scale == 1.0 and not s.unit else _scaled(raw, s.scale)
+
+
+def _scaled(raw: float, scale: float) -> float:
+    """raw x scale, as a division when the scale is 1/N (so 32050 x 0.01 reads 320.5, not 320.50000000000006)."""
+    if scale == 1.0:
+        return float(raw)
+    inverse = 1.0 / scale
+    if abs(inverse - round(inverse)) < 1e-9:
+        return raw / round(inverse)
+    return raw * scale
 
 
 @dataclass
@@ -296,7 +306,7 @@ class TwinClient:
         self.close()
 
     # -- the wire -----------------------------------------------------------------------------------
-    def _call(self, function: int, method: str, address: int, count: int, signals: Iterable[Signal], *args, **kw):
+    def _call(self, function: int, method: str, address: int, size: int, signals: Iterable[Signal], *args, **kw):
         if self._client is None:
             raise ConnectionFailedError(self.host, self.port, "not connected")
         from pymodbus.exceptions import ModbusException
@@ -310,7 +320,7 @@ class TwinClient:
             raise ConnectionFailedError(self.host, self.port, exc.strerror or str(exc)) from None
         if response.isError():
             code = getattr(response, "exception_code", 0)
-            raise ModbusExceptionError(code, function, address, count, self.unit_id, (s.name for s in signals))
+            raise ModbusExceptionError(code, function, address, size, self.unit_id, (s.name for s in signals))
         return response
 
     def read_signals(self, signals: Iterable[Signal]) -> dict[str, Any]:

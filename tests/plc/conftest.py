@@ -14,7 +14,7 @@ BENCH_INSIDE = HERE / "stations" / "ring_bench_inside"  # fingers at 150 mm in t
 RING_FORCES = ("L2.force", "L3.force", "L5.force")
 
 
-def ring_sequence(**overrides) -> GripSequence:
+def ring_sequence(**overrides):
     """The ring rig's grip sequence (mm, N): outside grips touch at 320 mm, inside grips at 200 mm."""
     return ring_rig.sequence(**overrides)
 
