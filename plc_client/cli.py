@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .client import RegisterMap, Signal, TwinClient
+from .client import RegisterMap, Signal, TwinClient, range_text
 from .errors import ConnectionFailedError, ModbusExceptionError, PlcClientError, SignalValueError
 
 EXIT_USER, EXIT_CONNECTION = 2, 1
@@ -209,7 +209,7 @@ def cmd_map(args) -> int:
     rows = [("name", "table", "address", "type", "unit", "range", "access")]
     for s in rmap:
         rows.append((s.name, s.table, str(s.address) if s.count == 1 else f"{s.address}-{s.address + s.count - 1}",
-                     s.type, s.unit, s.range_text(), "rw" if s.writable else "r"))
+                     s.type, s.unit, range_text(s), "rw" if s.writable else "r"))
     print_rows(rows, header=True)
     return 0
 
@@ -218,7 +218,7 @@ def cmd_map(args) -> int:
 def parse_value(s: Signal, text: str):
     """A command-line value for a signal: bools as 1/0, true/false, on/off; choices by text; else a number."""
     low = text.lower()
-    if s.is_bool:
+    if s.type == "bool":
         if low in TRUE:
             return True
         if low in FALSE:
@@ -230,7 +230,7 @@ def parse_value(s: Signal, text: str):
         value = float(text)
     except ValueError:
         raise SignalValueError(s.name, f"needs a number{' in ' + s.unit if s.unit else ''}, not {text!r}") from None
-    return int(value) if value.is_integer() and s.type != "float32" and s.scale == 1.0 and not s.unit else value
+    return int(value) if value.is_integer() and s.type != "float32" and s.scale == 1.0 else value
 
 
 def fmt(value) -> str:

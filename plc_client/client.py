@@ -18,55 +18,31 @@ import json
 import math
 import time
 from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, PlcClientError,
                      SignalValueError, UnknownSignalError, ValueOutOfRangeError)
+from .scan import LocalSignals
 
-COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER = "coil", "discrete_input", "holding_register", "input_register"
-TABLES = (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)
-BIT_TABLES = (COIL, DISCRETE_INPUT)
+from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
+                                      INPUT_REGISTER, LOCKSTEP, TABLES, Entry)
+
+Signal = Entry  # one entry of the register map, as the server builds it (twin.modbus.register_map)
 WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
 MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
 MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
-ADVANCE, STEP, TIME_MS = "sim.advance", "sim.step", "sim.time_ms"  # the lockstep registers
 
 
-@dataclass(frozen=True)
-class Signal:
-    """One entry of the register map."""
-
-    name: str
-    table: str
-    address: int  # 0-based protocol address
-    count: int = 1  # registers (or bits) it takes
-    type: str = "uint16"  # bool, uint16, int16, uint32, int32, float32
-    scale: float = 1.0  # engineering units per count
-    unit: str = ""
-    min: float | None = None
-    max: float | None = None
-    access: str = "r"
-    description: str = ""
-    choices: tuple[str, ...] = ()  # an enumeration: the value is the index into these
-
-    @property
-    def writable(self) -> bool:
-        return self.table in WRITABLE_TABLES and "w" in self.access
-
-    @property
-    def is_bool(self) -> bool:
-        return self.type == "bool" or self.table in BIT_TABLES
-
-    def range_text(self) -> str:
-        if self.is_bool:
-            return "0/1"
-        if self.choices:
-            return "|".join(c or '""' for c in self.choices)
-        lo = "" if self.min is None else f"{self.min:g}"
-        hi = "" if self.max is None else f"{self.max:g}"
-        return f"{lo}..{hi}" if (lo or hi) else ""
+def range_text(s: Signal) -> str:
+    if s.type == "bool":
+        return "0/1"
+    if s.choices:
+        return "|".join(c or '""' for c in s.choices)
+    lo = "" if s.min is None else f"{s.min:.10g}"
+    hi = "" if s.max is None else f"{s.max:.10g}"
+    return f"{lo}..{hi}" if (lo or hi) else ""
 
 
 class RegisterMap:
@@ -77,8 +53,12 @@ class RegisterMap:
         for s in signals:
             if s.table not in TABLES:
                 raise MapError(f"signal {s.name!r}: unknown table {s.table!r} (one of {', '.join(TABLES)})")
-            self.signals[s.name] = s
+            # the client speaks engineering units: encode(value) takes them as they are (factor 1)
+            self.signals[s.name] = replace(s, factor=1.0, signal=None)
         self.meta = dict(meta or {})
+        self.mapped: dict[str, set[int]] = {t: set() for t in TABLES}  # the addresses a read may cover
+        for s in self.signals.values():
+            self.mapped[s.table].update(range(s.address, s.address + s.count))
 
     # -- loading ------------------------------------------------------------------------------------
     @classmethod
@@ -109,19 +89,14 @@ class RegisterMap:
     @classmethod
     def from_station(cls, station: str | Path) -> "RegisterMap":
         """Build the map the server would serve for this station (with the server's own map builder)."""
-        try:
-            from twin.modbus import register_map as rm
-        except ImportError as exc:  # pragma: no cover - the server side is part of this project
-            raise MapError(f"cannot build the map of a station here ({exc}); use `twin map STATION --format json` "
-                           "and --map FILE") from None
         from twin.core.errors import TwinError
+        from twin.modbus import register_map as rm
 
         try:
-            built = rm.build_map(station) if hasattr(rm, "build_map") else rm.RegisterMap.from_station(station)
-            data = built.to_json() if hasattr(built, "to_json") else built.as_dict()
-        except TwinError as exc:
+            built = rm.build_map(station)
+        except (TwinError, rm.MapError) as exc:
             raise MapError(str(exc)) from None
-        return cls.from_json(data if not isinstance(data, str) else json.loads(data))
+        return cls(built.entries, {"station": built.station})
 
     # -- lookup -------------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> Signal:
@@ -155,10 +130,10 @@ def _signal_from_dict(e: Any, where: str, i: int) -> Signal:
     if not isinstance(e, Mapping) or "name" not in e or "table" not in e or "address" not in e:
         raise MapError(f"{where}: entry {i} needs at least name, table and address")
     try:
+        bit = e["table"] in BIT_TABLES
         return Signal(name=str(e["name"]), table=str(e["table"]), address=int(e["address"]), count=int(e.get("count", 1)),
-                      type=str(e.get("type", "bool" if e["table"] in BIT_TABLES else "uint16")),
-                      scale=float(e.get("scale") or 1.0), unit=str(e.get("unit") or ""),
-                      min=None if e.get("min") is None else float(e["min"]),
+                      type=str(e.get("type") or ("bool" if bit else "uint16")), scale=float(e.get("scale") or 1.0),
+                      unit=str(e.get("unit") or ""), min=None if e.get("min") is None else float(e["min"]),
                       max=None if e.get("max") is None else float(e["max"]),
                       access=str(e.get("access") or ("rw" if e["table"] in WRITABLE_TABLES else "r")),
                       description=str(e.get("description") or ""), choices=tuple(e.get("choices") or ()))
@@ -167,7 +142,7 @@ def _signal_from_dict(e: Any, where: str, i: int) -> Signal:
 
 
 def _check(s: Signal, value: Any) -> Any:
-    if s.is_bool:
+    if s.type == "bool":
         if isinstance(value, bool) or value in (0, 1):
             return bool(value)
         raise SignalValueError(s.name, f"needs true or false (1 or 0), not {value!r}")
@@ -182,55 +157,25 @@ def _check(s: Signal, value: Any) -> Any:
     return value
 
 
-# -- encode / decode (register words, big-endian, high word first) --------------------------------------
-_WIDTH = {"uint16": 1, "int16": 1, "uint32": 2, "int32": 2, "float32": 2}
-
-
-def encode(s: Signal, value: Any) -> list[int] | list[bool]:
-    """Engineering value -> register words (or one bit)."""
-    if s.table in BIT_TABLES:
-        return [bool(value)]
-    if s.type == "bool":
-        return [1 if value else 0]
-    import struct
-
-    if s.type == "float32":
-        raw = struct.unpack(">HH", struct.pack(">f", float(value) / s.scale))
-        return list(raw)
-    count = round(float(value) / s.scale)
-    fmt = {"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i"}[s.type]
-    try:
-        packed = struct.pack(fmt, count)
-    except struct.error:
-        raise ValueOutOfRangeError(s.name, value, None, None, s.unit) from None
-    return list(struct.unpack(">" + "H" * (len(packed) // 2), packed))
+# -- encode / decode: the server's own (twin.modbus.register_map.Entry), in engineering units ---------------
+def encode(s: Signal, value: Any) -> list:
+    """Engineering value (checked) -> register words, or [bit] for the bit tables."""
+    if s.choices and not isinstance(value, str):
+        value = s.choices[int(value)]
+    words = s.encode(value)
+    return [bool(w) for w in words] if s.table in BIT_TABLES else words
 
 
 def decode(s: Signal, words: list) -> Any:
-    """Register words (or bits) -> engineering value (bool, float, int, or the enumeration's text)."""
-    if s.table in BIT_TABLES:
-        return bool(words[0])
-    if s.type == "bool":
-        return bool(words[0])
-    import struct
-
-    data = struct.pack(">" + "H" * len(words), *words)
-    if s.type == "float32":
-        return _scaled(struct.unpack(">f", data)[0], s.scale)
-    raw = struct.unpack({"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i"}[s.type], data)[0]
-    if s.choices:
-        return s.choices[raw] if 0 <= raw < len(s.choices) else raw
-    return raw if s.scale == 1.0 and not s.unit else _scaled(raw, s.scale)
-
-
-def _scaled(raw: float, scale: float) -> float:
-    """raw x scale, as a division when the scale is 1/N (so 32050 x 0.01 reads 320.5, not 320.50000000000006)."""
-    if scale == 1.0:
-        return float(raw)
-    inverse = 1.0 / scale
-    if abs(inverse - round(inverse)) < 1e-9:
-        return raw / round(inverse)
-    return raw * scale
+    """Register words (or bits) -> engineering value (bool, number, or the enumeration's text)."""
+    value = s.decode([int(w) for w in words])
+    if isinstance(value, float) and s.type != "float32" and 0 < s.scale < 1:
+        digits = round(-math.log10(s.scale))
+        if math.isclose(s.scale, 10.0 ** -digits):
+            value = round(value, digits)  # 32050 counts of 0.01 mm read 320.5, not 320.50000000000006
+    elif isinstance(value, float) and s.scale == 1.0 and s.type != "float32":
+        value = int(value)
+    return value
 
 
 @dataclass
@@ -241,13 +186,17 @@ class _Run:
     signals: list[Signal] = field(default_factory=list)
 
 
-def plan_reads(signals: Iterable[Signal]) -> list[_Run]:
-    """Group signals into requests: contiguous addresses of one table, within the protocol's size limits."""
+def plan_reads(signals: Iterable[Signal], mapped: Mapping[str, set[int]] | None = None) -> list[_Run]:
+    """Group signals into requests: contiguous addresses of one table, within the protocol's size limits.
+    With `mapped` (the addresses the map covers, per table), a gap of mapped addresses is read through
+    too, so L2.actual and L2.force with L5.actual between them still take one request."""
     runs: list[_Run] = []
     for s in sorted(set(signals), key=lambda s: (TABLES.index(s.table), s.address)):
         limit = MAX_BITS if s.table in BIT_TABLES else MAX_REGISTERS
         last = runs[-1] if runs else None
-        if last and last.table == s.table and s.address <= last.end and max(last.end, s.address + s.count) - last.start <= limit:
+        joins = last is not None and last.table == s.table and max(last.end, s.address + s.count) - last.start <= limit and (
+            s.address <= last.end or (mapped is not None and all(a in mapped.get(s.table, ()) for a in range(last.end, s.address))))
+        if joins:
             last.end = max(last.end, s.address + s.count)
             last.signals.append(s)
         else:
@@ -325,7 +274,7 @@ class TwinClient:
 
     def read_signals(self, signals: Iterable[Signal]) -> dict[str, Any]:
         values: dict[str, Any] = {}
-        for run in plan_reads(signals):
+        for run in plan_reads(signals, self.map.mapped):
             n = run.end - run.start
             fc, method = {COIL: (1, "read_coils"), DISCRETE_INPUT: (2, "read_discrete_inputs"),
                           HOLDING_REGISTER: (3, "read_holding_registers"), INPUT_REGISTER: (4, "read_input_registers")}[run.table]
@@ -394,8 +343,14 @@ class TwinClient:
 
     # -- lockstep -----------------------------------------------------------------------------------
     @property
-    def lockstep_capable(self) -> bool:
-        return ADVANCE in self.map
+    def lockstep(self) -> bool:
+        """The server steps only through `sim.advance` (it was started with --lockstep)."""
+        return bool(self.get(LOCKSTEP)) if LOCKSTEP in self.map else False
+
+    @property
+    def dt(self) -> float:
+        """The simulation step, s."""
+        return self.get(DT_US) / 1e6
 
     def advance(self, steps: int, timeout: float = 30.0) -> None:
         """Lockstep: run `steps` simulation steps on the server and wait until they are done."""
@@ -412,24 +367,26 @@ class TwinClient:
             delay = min(delay * 2, 0.005)
 
 
-class ClientIO:
+class ClientIO(LocalSignals):
     """The network side of a scan cycle: `ScanCycle(ClientIO(client), logic)`.
 
     Lockstep (the server was started with `--lockstep`): each scan runs `cycle / dt` steps through
     `sim.advance` (carried over, so the average matches); otherwise the scan cycle paces itself against the
-    wall clock and the server runs in real time.
+    wall clock and the server runs in real time. `local`: signals the PLC holds itself (see `LocalSignals`).
     """
 
-    def __init__(self, client: TwinClient, *, lockstep: bool | None = None, dt: float | None = None):
+    def __init__(self, client: TwinClient, *, lockstep: bool | None = None, dt: float | None = None,
+                 local: Mapping[str, Any] | None = None):
+        super().__init__(local)
         self.client = client
-        self.lockstep = client.lockstep_capable if lockstep is None else lockstep
-        self.dt = dt or float(client.map.meta.get("step", client.map.meta.get("dt", 0.012)))
+        self.lockstep = client.lockstep if lockstep is None else lockstep
+        self.dt = dt or client.dt
         self._time, self._steps = 0.0, 0
 
-    def read_image(self, names: Iterable[str]) -> dict[str, Any]:
-        return self.client.read(*names)
+    def _read(self, names: list[str]) -> dict[str, Any]:
+        return self.client.read(*names) if names else {}
 
-    def write_image(self, values: Mapping[str, Any]) -> None:
+    def _write(self, values: dict[str, Any]) -> None:
         self.client.write(values)
 
     def advance(self, seconds: float) -> None:

@@ -159,23 +159,12 @@ class ScanCycle:
                 raise TimeoutError(f"no result after {timeout:g} s ({self.scans} scans); last inputs: {dict(image)}")
 
 
-class TwinIO:
-    """A twin in the same process as the PLC (tests, quick trials): lockstep, no network.
+class LocalSignals:
+    """Signals the PLC holds itself, next to the process's (e.g. the robot's handshake bits when a test
+    plays the robot): `io.set(name, value)` and `io.get(name)` reach them and the process alike."""
 
-    Values are published in the register map's engineering units (metres as mm) so the same logic runs
-    here and over the network. `local` adds signals the twin does not have (e.g. the robot's handshake
-    bits when a test plays the robot): `io.set("grip_request", True)`.
-    """
-
-    lockstep = True
-    SCALE = {"m": 1000.0}  # SI unit -> factor to the map's unit (m -> mm)
-
-    def __init__(self, twin, local: Mapping[str, Any] | None = None):
-        self.twin = twin
+    def __init__(self, local: Mapping[str, Any] | None = None):
         self.local: dict[str, Any] = dict(local or {})
-        self._scale = {s.name: self.SCALE.get(s.unit, 1.0) for s in twin.signals}
-        self._time = 0.0  # s the PLC asked to advance, carried over to whole steps
-        self._steps = 0
 
     def set(self, name: str, value: Any) -> None:
         if name in self.local:
@@ -187,20 +176,52 @@ class TwinIO:
         return self.read_image([name])[name]
 
     def read_image(self, names: Iterable[str]) -> dict[str, Any]:
-        out = {}
-        for n in names:
-            if n in self.local:
-                out[n] = self.local[n]
-            else:
-                v = self.twin.read(n)
-                out[n] = v * self._scale[n] if isinstance(v, float) else v
-        return out
+        names = list(names)
+        remote = self._read([n for n in names if n not in self.local])
+        return {n: self.local[n] if n in self.local else remote[n] for n in names}
 
     def write_image(self, values: Mapping[str, Any]) -> None:
         for n, v in values.items():
             if n in self.local:
                 self.local[n] = v
-            elif isinstance(v, (int, float)) and not isinstance(v, bool):
+        remote = {n: v for n, v in values.items() if n not in self.local}
+        if remote:
+            self._write(remote)
+
+    def _read(self, names: list[str]) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def _write(self, values: dict[str, Any]) -> None:
+        raise NotImplementedError
+
+
+class TwinIO(LocalSignals):
+    """A twin in the same process as the PLC (tests, quick trials): lockstep, no network.
+
+    Values are published in the register map's engineering units (metres as mm) so the same logic runs
+    here and over the network. `local`: signals the PLC holds itself (see `LocalSignals`).
+    """
+
+    lockstep = True
+    SCALE = {"m": 1000.0}  # SI unit -> factor to the map's unit (m -> mm)
+
+    def __init__(self, twin, local: Mapping[str, Any] | None = None):
+        super().__init__(local)
+        self.twin = twin
+        self._scale = {s.name: self.SCALE.get(s.unit, 1.0) for s in twin.signals}
+        self._time = 0.0  # s the PLC asked to advance, carried over to whole steps
+        self._steps = 0
+
+    def _read(self, names: list[str]) -> dict[str, Any]:
+        out = {}
+        for n in names:
+            v = self.twin.read(n)
+            out[n] = v * self._scale[n] if isinstance(v, float) else v
+        return out
+
+    def _write(self, values: dict[str, Any]) -> None:
+        for n, v in values.items():
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
                 self.twin.write(n, v / self._scale[n])
             else:
                 self.twin.write(n, v)

@@ -63,6 +63,13 @@ def test_contiguous_addresses_of_one_table_are_read_in_one_request(rmap):
         ("discrete_input", 0, 1), ("holding_register", 0, 4), ("input_register", 0, 4), ("input_register", 10, 11)]
 
 
+def test_a_gap_of_mapped_addresses_is_read_through_but_an_unmapped_one_is_not(rmap):
+    wanted = [rmap["L2.actual"], rmap["GrippedPart"], rmap["L2"]]
+    filler = {"input_register": set(range(0, 11)), "holding_register": {0, 1}}
+    assert [(r.start, r.end) for r in plan_reads(wanted, filler)] == [(0, 2), (0, 11)]
+    assert [(r.start, r.end) for r in plan_reads(wanted, rmap.mapped)] == [(0, 2), (0, 2), (10, 11)]
+
+
 def test_a_map_that_is_not_the_twin_map_output_is_a_clear_error(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
