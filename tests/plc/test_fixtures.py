@@ -1,0 +1,35 @@
+"""The pytest fixtures of plc_client.testing, used the way docs/commissioning-checks.md shows."""
+import importlib.util
+
+import pytest
+
+from plc_client import ScanCycle, plc_logic
+from tests.plc.conftest import BENCH
+
+pytest_plugins = ["plc_client.testing"]
+pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.cli") is None,
+                                reason="twin serve is not there yet (twin/modbus/cli.py)")
+
+
+@pytest.fixture
+def plc_station():
+    return BENCH
+
+
+def test_a_check_in_a_few_lines(twin_client):
+    twin_client.write(L2=320.5)
+    twin_client.advance(round(1.0 / 0.012))  # 1 s of simulated time
+    assert twin_client.get("L2.actual") == pytest.approx(320.5, abs=0.5)  # touching the ring: no force yet
+
+
+@plc_logic(inputs=["L2.force", "L2.actual"])
+def press(inputs, state):  # close L2 until it presses with 200 N, then hold
+    if inputs["L2.force"] >= 200.0:
+        state.done = True
+    return {} if getattr(state, "done", False) else {"L2": max(inputs["L2.actual"] - 1.0, 0.0)}
+
+
+def test_user_logic_on_the_scan_cycle_against_the_server(plc_server, twin_client):
+    plc = ScanCycle(plc_server.io(twin_client), press, cycle=0.010)
+    plc.run_until(lambda inputs, state: getattr(state, "done", False), timeout=10.0)
+    assert twin_client.get("L2.force") >= 200.0

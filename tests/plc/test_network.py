@@ -1,0 +1,141 @@
+"""The client, the `plc` command and the grip sequence against a real `twin serve` on loopback."""
+import importlib.util
+import os
+import subprocess
+import sys
+
+import pytest
+
+from plc_client import ClientIO, Phase, ScanCycle, TwinClient
+from plc_client.errors import ConnectionFailedError, UnknownSignalError, ValueOutOfRangeError
+from plc_client.testing import free_port, twin_server
+from tests.plc.conftest import BENCH, RING_FORCES, ring_sequence
+
+pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.cli") is None,
+                                reason="twin serve is not there yet (twin/modbus/cli.py)")
+EMPTY = BENCH.with_name("ring_bench_empty")  # the ring lies 2.4 m away: every grip misses
+
+
+@pytest.fixture(scope="module")
+def server():
+    with twin_server(BENCH, lockstep=True) as s:
+        yield s
+
+
+@pytest.fixture
+def client(server):
+    with server.client() as c:
+        yield c
+
+
+def plc(server, *args, timeout=20):
+    return subprocess.run([sys.executable, "-m", "plc_client", *server.plc_args(), *args], capture_output=True,
+                          text=True, timeout=timeout, env={**os.environ, "COLUMNS": "200"})
+
+
+# -- the client --------------------------------------------------------------------------------------------
+def test_a_batch_read_takes_one_request_per_run_of_addresses(client):
+    before = client.requests
+    values = client.read("L2.actual", "L3.actual", "L4.actual", *RING_FORCES)
+    assert client.requests - before == 1  # input registers 17..26, L5.actual between them read through
+    assert values["L2.actual"] == pytest.approx(330.0, abs=0.05)  # mm
+
+
+def test_a_write_takes_effect_at_the_next_steps_in_lockstep(client):
+    client.write(L2=325.0, L3=325.0)
+    assert client.read("L2", "L3") == {"L2": 325.0, "L3": 325.0}
+    client.advance(100)
+    assert client.get("L2.actual") == pytest.approx(325.0, abs=0.1)
+    client.write(L2=330.0, L3=330.0)
+    client.advance(100)
+
+
+def test_the_client_refuses_bad_names_and_values_before_the_wire(client):
+    before = client.requests
+    with pytest.raises(UnknownSignalError, match="did you mean 'L2.force'"):
+        client.read("L2.forc")
+    with pytest.raises(ValueOutOfRangeError, match="0 to 441 mm"):
+        client.write(L2=500.0)
+    assert client.requests == before
+
+
+def test_no_server_is_a_connection_error():
+    with pytest.raises(ConnectionFailedError, match=r"127.0.0.1:\d+"):
+        TwinClient.connect("127.0.0.1", free_port(), map=[{"name": "x", "table": "coil", "address": 0}], timeout=0.5)
+
+
+# -- the plc command -----------------------------------------------------------------------------------------
+def test_plc_read_prints_name_value_unit(server):
+    r = plc(server, "read", "L4", "L2.force", "doGripped", "GrippedPart")
+    assert r.returncode == 0, r.stderr
+    rows = [line.split() for line in r.stdout.splitlines()]
+    assert rows[0] == ["L4", "330", "mm"] and rows[1][0] == "L2.force" and rows[1][2] == "N"
+    assert rows[2] == ["doGripped", "0"] and rows[3] == ["GrippedPart", '""']
+
+
+def test_plc_write_sets_signals_in_engineering_units(server, client):
+    r = plc(server, "write", "L4=327.5", "Active=1")
+    assert r.returncode == 0, r.stderr
+    assert client.read("L4", "Active") == {"L4": 327.5, "Active": True}
+    client.write(L4=330.0)
+
+
+def test_plc_watch_prints_one_line_per_sample_when_not_a_terminal(server):
+    r = plc(server, "watch", "L2.actual", "sim.step", "--interval", "0.05", "--count", "3")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0].split() == ["t_s", "L2.actual[mm]", "sim.step[steps]"] and len(lines) == 4
+    assert all(len(line.split()) == 3 for line in lines[1:])
+
+
+def test_plc_unknown_name_is_exit_2_with_a_suggestion(server):
+    r = plc(server, "read", "L2.actul")
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip() == "plc: error: unknown signal 'L2.actul'; did you mean 'L2.actual'?"
+
+
+def test_plc_out_of_range_is_exit_2_naming_the_range(server, client):
+    r = plc(server, "write", "L3=300", "L2=450")
+    assert r.returncode == 2
+    assert r.stderr.strip() == "plc: error: signal 'L2': 450 mm is out of range: 0 to 441 mm"
+    assert client.get("L3") == 330.0  # all or nothing: L3 was not written either
+
+
+def test_plc_writing_an_output_is_exit_2(server):
+    r = plc(server, "write", "doGripped=1")
+    assert r.returncode == 2 and "output" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_plc_without_a_server_is_exit_1(server):
+    r = subprocess.run([sys.executable, "-m", "plc_client", "--port", str(free_port()), "--map", str(server.map_file),
+                        "--timeout", "0.5", "read", "L2"], capture_output=True, text=True, timeout=20)
+    assert r.returncode == 1 and r.stderr.startswith("plc: error: cannot reach a twin server at 127.0.0.1:")
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+# -- the grip sequence over the network -------------------------------------------------------------------------
+def grip_over_the_network(station):
+    """The robot's side played here: grip request, then the PLC scans (lockstep) until gripped or fault."""
+    seq = ring_sequence()
+    with twin_server(station, lockstep=True) as srv, srv.client() as c:
+        io = ClientIO(c, local=seq.handshake_signals())
+        plc_ = ScanCycle(io, seq)
+        io.set("grip_request", True)
+        image = plc_.run_until(lambda i, s: s.phase in (Phase.HELD, Phase.FAULT_MISSED), timeout=10.0)
+        plc_.run(seconds=0.2)
+        return plc_, dict(image), c.read("doGripped", "GrippedPart", "L2.actual", "L3.actual", "L4.actual", "sim.step")
+
+
+def test_a_grip_across_the_network_in_lockstep_is_the_same_on_every_run():
+    first, image, twin = grip_over_the_network(BENCH)
+    assert first.state.phase is Phase.HELD and twin["doGripped"] and twin["GrippedPart"] == "ring"
+    assert all(image[f] >= 200.0 for f in RING_FORCES)
+    again, image2, twin2 = grip_over_the_network(BENCH)
+    assert (again.scans, image2, twin2) == (first.scans, image, twin)
+
+
+def test_a_missed_grip_across_the_network_raises_the_fault_at_end_of_travel():
+    plc_, image, twin = grip_over_the_network(EMPTY)
+    assert plc_.state.phase is Phase.FAULT_MISSED and plc_.io.local["grip_fault"] and not plc_.io.local["gripped"]
+    assert not twin["doGripped"]
+    assert [twin[f"{a}.actual"] for a in ("L2", "L3", "L4")] == pytest.approx([290.0] * 3, abs=0.5)
