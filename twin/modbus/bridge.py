@@ -1,0 +1,118 @@
+"""The bridge between a twin and the register map: register images out, queued writes in.
+
+`TwinBridge.step()` is what a runner (`twin.pacing`) calls once per simulation step: it applies the
+writes queued since the last step (each request's writes together, in arrival order), steps the twin
+once, and publishes new register images. The server only ever reads published images, so a read sees
+the state after the last completed step, and a write takes effect at the next step.
+
+The twin is anything with `signals`, `read(name)`, `write(name, value)`, `step()`, `step_count`,
+`time` and `dt` (the `twin.core.Twin` contract). The bridge imports neither sockets nor clocks.
+"""
+from __future__ import annotations
+
+import struct
+import sys
+import traceback
+from collections.abc import Callable, Sequence
+
+from .register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, FAULT, HOLDING_REGISTER,
+                           INPUT_REGISTER, LATE, LATE_STEPS, LOCKSTEP, MODE, SPEED_PCT, STEP, TIME_MS, Entry,
+                           RegisterMap)
+from .server import ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE, Images
+
+
+def _log(text: str) -> None:
+    print(f"twin serve: {text}", file=sys.stderr, flush=True)
+
+
+class TwinBridge:
+    """Publishes a twin's signals as register images and queues writes for the next step."""
+
+    def __init__(self, twin, rmap: RegisterMap, *, log: Callable[[str], None] = _log):
+        self.twin, self.map, self.log = twin, rmap, log
+        self.runner = None  # set by whoever paces the twin (twin.pacing): mode, speed, late_steps, remaining
+        self.fault = False
+        self._queue: list[Sequence[tuple[Entry, object]]] = []
+        self._sizes = {t: rmap.size(t) for t in (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)}
+        self._entries = {t: rmap.table(t) for t in self._sizes}
+        self._advance = rmap[ADVANCE] if ADVANCE in rmap else None
+        self.images: Images = Images(b"", b"", b"", b"")
+        self.publish()
+
+    # -- the server's side ----------------------------------------------------------------------------
+    def submit(self, changes: Sequence[tuple[Entry, object]]) -> int:
+        if self.fault:
+            return SERVER_DEVICE_FAILURE
+        signals = []
+        for entry, value in changes:
+            if entry.name == ADVANCE:
+                n = int(value)
+                runner = self.runner
+                if runner is None or runner.mode != "lockstep":
+                    if n != 0:
+                        return ILLEGAL_DATA_VALUE
+                elif runner.remaining + n > 0xFFFF:
+                    return ILLEGAL_DATA_VALUE
+            elif entry.signal is not None:
+                signals.append((entry, value))
+        for entry, value in changes:  # checked: now act
+            if entry.name == ADVANCE and int(value) and self.runner is not None and self.runner.mode == "lockstep":
+                self.runner.request(int(value))
+        if signals:
+            self._queue.append(signals)
+        return 0
+
+    def live_holding(self, address: int) -> int | None:
+        if self._advance is not None and address == self._advance.address:
+            return 0 if self.runner is None else min(0xFFFF, self.runner.remaining)
+        return None
+
+    # -- the runner's side ----------------------------------------------------------------------------
+    def step(self) -> bool:
+        """Apply queued writes, run one step, publish. False (and the fault bit) if the twin failed."""
+        if self.fault:
+            return False
+        queue, self._queue = self._queue, []
+        try:
+            for batch in queue:
+                for entry, value in batch:
+                    self.twin.write(entry.signal, value)
+            self.twin.step()
+        except Exception as exc:  # a physics or device error: keep serving the last state, flag it
+            self.fault = True
+            self.log(f"simulation fault at step {self.twin.step_count}: {type(exc).__name__}: {exc}")
+            traceback.print_exc(file=sys.stderr)
+            self.publish()
+            return False
+        self.publish()
+        return True
+
+    def _status(self) -> dict:
+        twin, runner = self.twin, self.runner
+        lockstep = runner is not None and runner.mode == "lockstep"
+        return {
+            FAULT: self.fault, LOCKSTEP: lockstep, LATE: bool(runner is not None and runner.last_late),
+            STEP: twin.step_count, TIME_MS: round(twin.time * 1000), DT_US: round(twin.dt * 1e6),
+            LATE_STEPS: 0 if runner is None else runner.late_steps, MODE: 0 if lockstep else 1,
+            SPEED_PCT: 0 if runner is None or lockstep else round(runner.speed * 100), ADVANCE: 0,
+        }
+
+    def publish(self) -> None:
+        status = self._status()
+        read = self.twin.read
+        images = {}
+        for table, entries in self._entries.items():
+            size = self._sizes[table]
+            if table in BIT_TABLES:
+                img = bytearray(size)
+                for e in entries:
+                    v = read(e.signal) if e.signal is not None else status.get(e.name, 0)
+                    img[e.address] = 1 if v else 0
+                images[table] = bytes(img)
+            else:
+                words = [0] * size
+                for e in entries:
+                    v = read(e.signal) if e.signal is not None else status.get(e.name, 0)
+                    words[e.address:e.end] = e.encode(v)
+                images[table] = struct.pack(f">{size}H", *words)
+        self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])

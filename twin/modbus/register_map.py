@@ -1,0 +1,395 @@
+"""The Modbus register map: derived from a station's signal table, never written by hand.
+
+`build_register_map(signals)` is a pure function of the signal table (`twin.core.signals.SignalSpec`,
+in the station's declaration order). The one frozen `RegisterMap` it returns feeds the server, the
+json/csv/md exports (`twin map`) and the PLC client's name lookup.
+
+Layout (addresses are 0-based protocol addresses):
+
+- Every table starts with a block of `RESERVED` (16) addresses that belongs to the twin itself (the
+  `sim.*` registers and the `fault` bit). Station signals start at address 16 of each table, in the
+  signal table's order, so adding a signal at the end of the station (or a new `sim.*` register in the
+  reserved block) never moves another entry. Unused reserved addresses are gaps: reading them gives
+  exception 02.
+- coils (read/write bits): the digital inputs (`Active`, ...).
+- discrete inputs (read-only bits): `fault`, `sim.lockstep`, `sim.late`, then the digital outputs
+  (`doGripped`, per axis `.in_position` and `.moving`, per finger `.contact`).
+- holding registers (read/write words): `sim.advance` at 0, then the analogue inputs.
+- input registers (read-only words): `sim.step`, `sim.time_ms`, `sim.late_steps`, `sim.dt_us`,
+  `sim.mode`, `sim.speed_pct`, then the analogue outputs (actual positions, finger forces, robot axes)
+  and `GrippedPart` (an index into the target group, 0 for none).
+
+Values are scaled integers in the engineering units the PLC sees, `value = counts * scale`:
+
+=========  ==========  ==================  ===============================================
+SI unit    map unit    scale (per count)   e.g.
+=========  ==========  ==================  ===============================================
+m          mm          0.01                prismatic setpoints and positions (0.01 mm)
+rad        deg         0.01                revolute setpoints and positions (0.01 degree)
+N, N*m     N, N*m      0.01                finger forces
+=========  ==========  ==================  ===============================================
+
+The type is the smallest that holds the signal's range: uint16, int16, then uint32, int32 (a signal
+without a range gets a 32-bit type); a float signal in another unit is a float32 of its SI value.
+32-bit values take two registers, **big-endian, high word first** (and big-endian bytes in each word).
+Enumerations are uint16 indices into their `choices` (0 = none). Outputs saturate at their type's
+limits (a finger a hair past its joint limit reads as the limit); inputs outside their range are
+refused (exception 03), never clamped.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import struct
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, field
+
+from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
+
+COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER = "coil", "discrete_input", "holding_register", "input_register"
+TABLES = (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)
+BIT_TABLES = (COIL, DISCRETE_INPUT)
+RESERVED = 16  # addresses 0..15 of every table belong to the twin (sim.* and fault)
+
+# Conventional 1-based "Modicon" references, for the printed map.
+REFERENCE_BASE = {COIL: 1, DISCRETE_INPUT: 10001, INPUT_REGISTER: 30001, HOLDING_REGISTER: 40001}
+
+WIDTH = {"bool": 1, "uint16": 1, "int16": 1, "uint32": 2, "int32": 2, "float32": 2}
+_LIMITS = {"uint16": (0, 0xFFFF), "int16": (-0x8000, 0x7FFF), "uint32": (0, 0xFFFFFFFF),
+           "int32": (-0x80000000, 0x7FFFFFFF), "bool": (0, 1)}
+_STRUCT = {"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i", "float32": ">f"}
+
+# SI unit -> (map unit, factor from SI to the map unit, scale in map units per count)
+UNITS = {
+    "m": ("mm", 1000.0, 0.01),
+    "rad": ("deg", 180.0 / math.pi, 0.01),
+    "N": ("N", 1.0, 0.01),
+    "N*m": ("N*m", 1.0, 0.01),
+}
+
+# The twin's own registers (fixed addresses inside the reserved block).
+ADVANCE, STEP, TIME_MS, LATE_STEPS, DT_US, MODE, SPEED_PCT = (
+    "sim.advance", "sim.step", "sim.time_ms", "sim.late_steps", "sim.dt_us", "sim.mode", "sim.speed_pct")
+FAULT, LOCKSTEP, LATE = "fault", "sim.lockstep", "sim.late"
+
+
+class MapError(ValueError):
+    """The signal table cannot be turned into a register map (e.g. a duplicate name)."""
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One named value at an address of one table."""
+
+    name: str
+    table: str  # coil, discrete_input, holding_register, input_register
+    address: int  # 0-based protocol address
+    count: int  # registers (or bits) it takes
+    type: str  # bool, uint16, int16, uint32, int32, float32
+    scale: float  # engineering units per count
+    unit: str  # the engineering unit the PLC sees (mm, deg, N, ...)
+    min: float | None  # in engineering units
+    max: float | None
+    access: str  # "r" or "rw"
+    description: str
+    choices: tuple[str, ...] = ()  # enumerations: the value is an index into these ("" = none)
+    signal: str | None = None  # the twin signal it carries (None: the twin's own sim.* entries)
+    factor: float = 1.0  # SI value * factor = engineering value
+
+    @property
+    def writable(self) -> bool:
+        return self.access == "rw"
+
+    @property
+    def end(self) -> int:
+        return self.address + self.count
+
+    @property
+    def reference(self) -> int:
+        """The conventional 1-based reference (00001, 10001, 30001, 40001 + address)."""
+        return REFERENCE_BASE[self.table] + self.address
+
+    # -- counts ---------------------------------------------------------------------------------------
+    @property
+    def count_range(self) -> tuple[float, float]:
+        """The counts a write may carry (inclusive); floats for float32."""
+        if self.type == "bool":
+            return 0, 1
+        if self.type == "float32":
+            lo = -math.inf if self.min is None else self.min
+            hi = math.inf if self.max is None else self.max
+            return lo, hi
+        tlo, thi = _LIMITS[self.type]
+        lo = tlo if self.min is None else max(tlo, math.ceil(self.min / self.scale - 1e-6))
+        hi = thi if self.max is None else min(thi, math.floor(self.max / self.scale + 1e-6))
+        return lo, hi
+
+    # -- engineering value <-> words ------------------------------------------------------------------
+    def counts_of(self, value) -> int | float:
+        """SI value (as the twin reads it) -> counts (saturated at the type's limits)."""
+        if self.type == "bool":
+            return 1 if value else 0
+        if self.choices:
+            if isinstance(value, int) and not isinstance(value, bool):
+                return value
+            return self.choices.index(value) if value in self.choices else 0
+        if isinstance(value, bool):
+            value = int(value)
+        if self.type == "float32":
+            return float(value) * self.factor
+        v = float(value) * self.factor / self.scale
+        if math.isnan(v):
+            return 0
+        lo, hi = _LIMITS[self.type]
+        return lo if v <= lo else hi if v >= hi else int(round(v))
+
+    def encode(self, value) -> list[int]:
+        """SI value -> register words (big-endian, high word first), or [0/1] for a bit."""
+        c = self.counts_of(value)
+        if self.type in ("bool", "uint16"):
+            return [c]
+        if self.type == "int16":
+            return [c & 0xFFFF]
+        raw = struct.pack(_STRUCT[self.type], c)
+        return [int.from_bytes(raw[:2], "big"), int.from_bytes(raw[2:], "big")]
+
+    def decode_counts(self, words: list[int]) -> int | float:
+        """Register words (or [bit]) -> counts (or the float32 value)."""
+        if self.type in ("bool", "uint16"):
+            return words[0]
+        if self.type == "int16":
+            return words[0] - 0x10000 if words[0] & 0x8000 else words[0]
+        raw = struct.pack(">HH", words[0], words[1])
+        return struct.unpack(_STRUCT[self.type], raw)[0]
+
+    def decode(self, words: list[int]):
+        """Register words -> engineering value (bool, the enumeration's text, or counts * scale)."""
+        c = self.decode_counts(words)
+        if self.type == "bool":
+            return bool(c)
+        if self.choices:
+            return self.choices[c] if 0 <= c < len(self.choices) else c
+        return c * self.scale
+
+    def si_of_words(self, words: list[int]):
+        """Register words written by a client -> the SI value for the twin, or None when out of range.
+
+        A value on the range's edge (in counts) maps inside the SI range even after rounding."""
+        c = self.decode_counts(words)
+        if isinstance(c, float) and math.isnan(c):
+            return None
+        lo, hi = self.count_range
+        if not lo <= c <= hi:
+            return None
+        if self.type == "bool":
+            return bool(c)
+        if self.choices:
+            return self.choices[c]
+        if self.type == "float32":
+            return c / self.factor
+        si = c * self.scale / self.factor
+        if self.signal is not None and self.min is not None:
+            si = max(si, self.min / self.factor)
+        if self.signal is not None and self.max is not None:
+            si = min(si, self.max / self.factor)
+        return si
+
+    def as_dict(self) -> dict:
+        d = {k: v for k, v in asdict(self).items() if k not in ("signal", "factor")}
+        d["choices"] = list(self.choices)
+        return d
+
+
+@dataclass(frozen=True)
+class RegisterMap:
+    """All entries, grouped by table in address order. Built by `build_register_map`."""
+
+    entries: tuple[Entry, ...]
+    station: str = ""
+    by_name: Mapping[str, Entry] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "by_name", {e.name: e for e in self.entries})
+
+    def __iter__(self):
+        return iter(self.entries)
+
+    def __len__(self) -> int:
+        return len(self.entries)
+
+    def __getitem__(self, name: str) -> Entry:
+        return self.by_name[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.by_name
+
+    def table(self, table: str) -> tuple[Entry, ...]:
+        return tuple(e for e in self.entries if e.table == table)
+
+    def size(self, table: str) -> int:
+        """One past the highest address used in `table`."""
+        return max((e.end for e in self.entries if e.table == table), default=0)
+
+    # -- exports --------------------------------------------------------------------------------------
+    def as_list(self) -> list[dict]:
+        return [e.as_dict() for e in self.entries]
+
+    def to_json(self) -> str:
+        return json.dumps(self.as_list(), indent=2) + "\n"
+
+    def to_csv(self) -> str:
+        out = io.StringIO()
+        cols = ["name", "table", "address", "count", "type", "scale", "unit", "min", "max", "access",
+                "description", "choices"]
+        w = csv.writer(out, lineterminator="\n")
+        w.writerow(cols)
+        for d in self.as_list():
+            d["choices"] = "|".join(d["choices"])
+            w.writerow(["" if d[c] is None else _num(d[c]) for c in cols])
+        return out.getvalue()
+
+    def to_markdown(self) -> str:
+        title = f"# Modbus register map: station `{self.station}`" if self.station else "# Modbus register map"
+        lines = [title, "",
+                 "Modbus/TCP, one unit. Addresses are 0-based protocol addresses; `Ref` is the conventional",
+                 "1-based reference (coil 00001, discrete input 10001, input register 30001, holding register 40001).",
+                 "32-bit values take two registers, big-endian, **high word first**. Value = counts x scale,",
+                 "in the unit shown (lengths in mm, angles in degrees, forces in N). Bits: 1 = true.",
+                 f"Addresses 0 to {RESERVED - 1} of each table belong to the simulator; station signals start at {RESERVED}.",
+                 "Writes take effect at the next simulation step; reads show the state after the last completed step.",
+                 "Out of range: exception 03, nothing changes. Address not in the map: exception 02.", ""]
+        names = {COIL: "Coils (read/write bits, FC 1, 5, 15)",
+                 DISCRETE_INPUT: "Discrete inputs (read-only bits, FC 2)",
+                 HOLDING_REGISTER: "Holding registers (read/write, FC 3, 6, 16, 23)",
+                 INPUT_REGISTER: "Input registers (read-only, FC 4)"}
+        for table in TABLES:
+            rows = self.table(table)
+            lines += [f"## {names[table]}", ""]
+            if not rows:
+                lines += ["(none)", ""]
+                continue
+            lines.append("| Addr | Ref | Name | Type | Unit | Scale | Range | Access | Description |")
+            lines.append("|---:|---:|---|---|---|---:|---|---|---|")
+            for e in rows:
+                addr = f"{e.address}" if e.count == 1 else f"{e.address}-{e.end - 1}"
+                ref = f"{e.reference:05d}"
+                desc = e.description
+                if e.choices:
+                    desc += " (" + ", ".join(f"{i} = {c or 'none'}" for i, c in enumerate(e.choices)) + ")"
+                lines.append(f"| {addr} | {ref} | `{e.name}` | {e.type} | {e.unit} | "
+                             f"{'' if e.type == 'bool' else _num(e.scale)} | {_range(e)} | {e.access} | "
+                             f"{desc.replace('|', '/')} |")
+            lines.append("")
+        return "\n".join(lines)
+
+
+def _num(v):
+    if isinstance(v, float):
+        return f"{v:.10g}"
+    return v
+
+
+def _range(e: Entry) -> str:
+    if e.type == "bool":
+        return "0/1"
+    lo = "" if e.min is None else f"{e.min:.10g}"
+    hi = "" if e.max is None else f"{e.max:.10g}"
+    return f"{lo} .. {hi}".strip() if (lo or hi) else ""
+
+
+# -- building ------------------------------------------------------------------------------------------
+def _sim_entries() -> list[Entry]:
+    u32 = (0, float(0xFFFFFFFF))
+    E = Entry
+    return [
+        E(ADVANCE, HOLDING_REGISTER, 0, 1, "uint16", 1.0, "steps", 0, 65535, "rw",
+          "lockstep: write N to run N more steps; reads the steps still to run (0 when done). "
+          "Real time: reads 0 and only 0 may be written (else exception 03)"),
+        E(FAULT, DISCRETE_INPUT, 0, 1, "bool", 1.0, "", None, None, "r",
+          "the simulation stopped on an error (see the server's log); outputs are frozen, writes get exception 04"),
+        E(LOCKSTEP, DISCRETE_INPUT, 1, 1, "bool", 1.0, "", None, None, "r",
+          "the server runs in lockstep (steps only through sim.advance)"),
+        E(LATE, DISCRETE_INPUT, 2, 1, "bool", 1.0, "", None, None, "r",
+          "real time: the last step finished after its wall-clock deadline"),
+        E(STEP, INPUT_REGISTER, 0, 2, "uint32", 1.0, "steps", *u32, "r", "simulation steps completed"),
+        E(TIME_MS, INPUT_REGISTER, 2, 2, "uint32", 1.0, "ms", *u32, "r", "simulated time (steps x step length)"),
+        E(LATE_STEPS, INPUT_REGISTER, 4, 2, "uint32", 1.0, "steps", *u32, "r",
+          "real time: steps that finished after their wall-clock deadline"),
+        E(DT_US, INPUT_REGISTER, 6, 1, "uint16", 1.0, "us", 0, 65535, "r", "simulation step length"),
+        E(MODE, INPUT_REGISTER, 7, 1, "uint16", 1.0, "", 0, 1, "r", "0 = lockstep, 1 = real time"),
+        E(SPEED_PCT, INPUT_REGISTER, 8, 1, "uint16", 1.0, "%", 0, 65535, "r",
+          "real time: speed in percent of real time (100 = real time); 0 in lockstep"),
+    ]
+
+
+def _fit_type(lo_e: float | None, hi_e: float | None, scale: float, signed_default: bool) -> str:
+    if lo_e is None or hi_e is None:
+        return "int32" if (lo_e is None or lo_e < 0 or signed_default) else "uint32"
+    lo, hi = math.ceil(lo_e / scale - 1e-6), math.floor(hi_e / scale + 1e-6)
+    for t in ("uint16", "int16", "uint32", "int32"):
+        tlo, thi = _LIMITS[t]
+        if tlo <= lo and hi <= thi:
+            return t
+    return "float32"
+
+
+def _eng(v: float | None, factor: float) -> float | None:
+    return None if v is None else round(v * factor, 9)
+
+
+def _signal_entry(s: SignalSpec, table: str, address: int) -> Entry:
+    access = "rw" if s.direction == INPUT else "r"
+    common = dict(name=s.name, table=table, address=address, access=access, description=s.description, signal=s.name)
+    if table in BIT_TABLES:
+        return Entry(count=1, type="bool", scale=1.0, unit="", min=None, max=None, **common)
+    if s.type == ENUM:
+        return Entry(count=1, type="uint16", scale=1.0, unit="", min=0, max=max(0, len(s.choices) - 1),
+                     choices=tuple(s.choices), **common)
+    if s.type == INT:
+        t = _fit_type(s.min, s.max, 1.0, False)
+        return Entry(count=WIDTH[t], type=t, scale=1.0, unit=s.unit, min=s.min, max=s.max, **common)
+    if s.unit in UNITS:
+        unit, factor, scale = UNITS[s.unit]
+        lo, hi = _eng(s.min, factor), _eng(s.max, factor)
+        t = _fit_type(lo, hi, scale, False)
+        if t != "float32":
+            return Entry(count=WIDTH[t], type=t, scale=scale, unit=unit, min=lo, max=hi, factor=factor, **common)
+    return Entry(count=2, type="float32", scale=1.0, unit=s.unit, min=s.min, max=s.max, **common)
+
+
+def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> RegisterMap:
+    """The register map of a signal table (see the module docstring for the layout)."""
+    entries = _sim_entries()
+    seen = {e.name for e in entries}
+    nxt = {t: RESERVED for t in TABLES}
+    for s in signals:
+        if s.name in seen:
+            raise MapError(f"signal {s.name!r} appears twice (or clashes with the simulator's own entry)")
+        seen.add(s.name)
+        if s.type == BOOL:
+            table = COIL if s.direction == INPUT else DISCRETE_INPUT
+        elif s.type in (FLOAT, INT, ENUM):
+            table = HOLDING_REGISTER if s.direction == INPUT else INPUT_REGISTER
+        else:  # text and other types are not served (none exist yet)
+            continue
+        e = _signal_entry(s, table, nxt[table])
+        nxt[table] = e.end
+        if e.end > 0x10000:
+            raise MapError(f"signal {s.name!r}: the {table} table is full (65536 addresses)")
+        entries.append(e)
+    order = {t: i for i, t in enumerate(TABLES)}
+    entries.sort(key=lambda e: (order[e.table], e.address))
+    return RegisterMap(tuple(entries), station)
+
+
+def build_map(station) -> RegisterMap:
+    """The map `twin serve` serves for a station (a folder or a station.toml): builds its twin."""
+    from .cli import open_twin
+
+    twin = open_twin(station)
+    try:
+        return build_register_map(twin.signals, twin.station.name)
+    finally:
+        twin.close()

@@ -1,0 +1,126 @@
+"""Runners that pace a stepped simulation: the only module that knows the wall clock.
+
+The core (`twin.core`) has no clock: its time is step count x dt. Something has to decide *when* to
+step. Two runners do, both as asyncio tasks that share the event loop with the server that exposes
+the simulation (so a step and a request never interleave: a read sees a completed step):
+
+- `RealtimeRunner(step, dt, speed)`: step k is due at t0 + k * dt / speed on the wall clock. The runner
+  sleeps until a step's start time, runs it, and counts it *late* when it finishes after its due time
+  (the state for simulated time t was not ready when the wall clock reached t). A late runner catches
+  up by running the following steps back to back; when it is more than `max_lag` behind it stops
+  catching up and restarts its schedule from now (like a PLC that skips cycles), still counting.
+- `LockstepRunner(step)`: steps only when asked. `request(n)` adds n steps; `remaining` is how many are
+  still to run. The simulation never moves on its own, so a scripted client gets the same results,
+  bit for bit, run after run.
+
+`step` is a callable that runs one simulation step and returns False when the simulation cannot go on
+(a fault): the runner then stops stepping.
+"""
+from __future__ import annotations
+
+import asyncio
+import time
+from collections.abc import Callable
+
+Step = Callable[[], bool]
+
+
+class RealtimeRunner:
+    """Step at `speed` times real time against the wall clock (see the module docstring)."""
+
+    mode = "realtime"
+
+    def __init__(self, step: Step, dt: float, speed: float = 1.0, *, max_lag: float = 0.5,
+                 clock: Callable[[], float] = time.perf_counter):
+        if not dt > 0 or not speed > 0:
+            raise ValueError("dt and speed must be positive")
+        self.step, self.dt, self.speed, self.max_lag, self.clock = step, dt, speed, max_lag, clock
+        self.period = dt / speed
+        self.steps = 0
+        self.late_steps = 0
+        self.last_late = False
+        self.resyncs = 0
+        self.max_late = 0.0  # s, the worst lateness seen
+        self._stop = False
+
+    @property
+    def remaining(self) -> int:
+        return 0
+
+    def stop(self) -> None:
+        self._stop = True
+
+    async def run(self) -> None:
+        clock, period = self.clock, self.period
+        t0 = clock()
+        k = 0  # steps run since t0
+        while not self._stop:
+            delay = t0 + k * period - clock()
+            # Sleep until the step's start; never run two steps without letting the server answer.
+            await asyncio.sleep(delay if delay > 0 else 0)
+            if self._stop:
+                break
+            if not self.step():
+                return
+            k += 1
+            self.steps += 1
+            lateness = clock() - (t0 + k * period)
+            self.last_late = lateness > 0
+            if self.last_late:
+                self.late_steps += 1
+                self.max_late = max(self.max_late, lateness)
+                if lateness > self.max_lag:
+                    t0, k = clock(), 0
+                    self.resyncs += 1
+
+
+class LockstepRunner:
+    """Step only on request (`request(n)`), as fast as possible, yielding to the server between steps."""
+
+    mode = "lockstep"
+    speed = 0.0
+    late_steps = 0
+    last_late = False
+
+    def __init__(self, step: Step, *, slice_s: float = 0.002, clock: Callable[[], float] = time.perf_counter):
+        self.step, self.slice_s, self.clock = step, slice_s, clock
+        self.steps = 0
+        self.target = 0
+        self._wake: asyncio.Event | None = None
+        self._stop = False
+        self.failed = False
+
+    @property
+    def remaining(self) -> int:
+        return self.target - self.steps
+
+    def request(self, n: int) -> None:
+        if self.failed:
+            return
+        self.target += n
+        if self._wake is not None:
+            self._wake.set()
+
+    def stop(self) -> None:
+        self._stop = True
+        if self._wake is not None:
+            self._wake.set()
+
+    async def run(self) -> None:
+        self._wake = asyncio.Event()
+        clock = self.clock
+        while not self._stop:
+            if self.steps >= self.target:
+                self._wake.clear()
+                await self._wake.wait()
+                continue
+            t_yield = clock() + self.slice_s
+            while self.steps < self.target and not self._stop:
+                if not self.step():
+                    self.failed = True
+                    self.target = self.steps
+                    return
+                self.steps += 1
+                if clock() >= t_yield:
+                    break
+            await asyncio.sleep(0)
