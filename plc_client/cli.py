@@ -14,6 +14,7 @@ value, bad map) and 1 when the server cannot be reached or refuses a request.
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 
 from .client import RegisterMap, Signal, TwinClient, range_text
@@ -257,6 +258,7 @@ class UsageError(PlcClientError):
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # its own log lines would repeat ours
     try:
         return args.func(args)
     except (ConnectionFailedError, ModbusExceptionError) as exc:

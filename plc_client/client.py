@@ -98,6 +98,10 @@ class RegisterMap:
             raise MapError(str(exc)) from None
         return cls(built.entries, {"station": built.station})
 
+    def as_list(self) -> list[dict]:
+        """The map as `twin map --format json` prints it."""
+        return [s.as_dict() for s in self.signals.values()]
+
     # -- lookup -------------------------------------------------------------------------------------
     def __getitem__(self, name: str) -> Signal:
         try:

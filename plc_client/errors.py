@@ -34,7 +34,7 @@ class UnknownSignalError(PlcClientError, KeyError):
     def __init__(self, name: str, known: Iterable[str] = ()):
         self.signal = name
         self.suggestions = tuple(difflib.get_close_matches(name, list(known), n=3, cutoff=0.6))
-        hint = f"; did you mean {' or '.join(repr(s) for s in self.suggestions)}?" if self.suggestions else \
+        hint = f"; did you mean {self.suggestions[0]!r}?" if self.suggestions else \
             " (`plc map` lists the signals)"
         super().__init__(f"unknown signal {name!r}{hint}")
 

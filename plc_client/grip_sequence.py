@@ -204,7 +204,7 @@ class GripSequence:
             goal = inputs[h.prepare_position] if h.prepare_position else self.ready_position.get(mode)
             if goal is not None:
                 state.phase, state.fault, state.goal, state.since = Phase.PREPARING, Fault.NONE, float(goal), now
-                state.setpoint = dict(actual)
+                state.setpoint, state.at_end_since = dict(actual), None
 
         if state.phase is Phase.GRIPPING:
             self._grip_scan(state, forces, actual, elapsed, now)
@@ -214,7 +214,7 @@ class GripSequence:
             step = self.speed * elapsed
             for a in self.axes:
                 state.setpoint[a] = _towards(state.setpoint[a], state.goal, step)
-            if all(abs(actual[a] - state.goal) <= self.tolerance for a in self.axes):
+            if self._arrived(state, {a: state.goal for a in self.axes}, actual, now):
                 state.phase = Phase.IDLE
 
         if state.phase in (Phase.GRIPPING, Phase.RELEASING, Phase.PREPARING) or state.setpoint:
@@ -256,14 +256,8 @@ class GripSequence:
             state.setpoint[a] = _towards(state.setpoint[a], end, step)
         # a miss: every axis still looking for force has its setpoint at the end of travel and is there
         # (or has had `settle` seconds to get there)
-        if all(state.setpoint[a] == end for a in moving):
-            if state.at_end_since is None:
-                state.at_end_since = now
-            arrived = all(abs(actual[a] - end) <= self.tolerance for a in moving)
-            if arrived or now - state.at_end_since >= self.settle:
-                state.phase, state.fault = Phase.FAULT_MISSED, Fault.MISSED
-        else:
-            state.at_end_since = None
+        if self._arrived(state, {a: end for a in moving}, actual, now):
+            state.phase, state.fault = Phase.FAULT_MISSED, Fault.MISSED
 
     def _start_release(self, state: GripState, actual: dict[str, float], now: float) -> None:
         opening = -self.close_direction[state.mode]
@@ -291,17 +285,21 @@ class GripSequence:
         step = self.speed * elapsed
         for a in self.axes:
             state.setpoint[a] = _towards(state.setpoint[a], targets[a], step)
-        if all(state.setpoint[a] == targets[a] for a in self.axes):
-            if state.at_end_since is None:
-                state.at_end_since = now
-            arrived = all(abs(actual[a] - targets[a]) <= self.tolerance for a in self.axes)
-            if arrived or now - state.at_end_since >= self.settle:
-                if free:
-                    state.phase = Phase.IDLE
-                else:
-                    state.phase, state.fault = Phase.FAULT_STUCK, Fault.STUCK
-        else:
+        if self._arrived(state, targets, actual, now):
+            if free:
+                state.phase = Phase.IDLE
+            else:
+                state.phase, state.fault = Phase.FAULT_STUCK, Fault.STUCK
+
+    def _arrived(self, state: GripState, targets: Mapping[str, float], actual: Mapping[str, float], now: float) -> bool:
+        """Every setpoint is at its target and every axis there too (or has had `settle` s to get there)."""
+        if not all(state.setpoint[a] == targets[a] for a in targets):
             state.at_end_since = None
+            return False
+        if state.at_end_since is None:
+            state.at_end_since = now
+        return (all(abs(actual[a] - targets[a]) <= self.tolerance for a in targets)
+                or now - state.at_end_since >= self.settle)
 
     def _release_target(self, state: GripState, free_at: float, opening: int) -> float:
         """Where an axis opens to once the part is free: a margin further, at least to the ready position."""

@@ -25,7 +25,9 @@ True) chooses lockstep or real time. See docs/commissioning-checks.md.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -97,67 +99,54 @@ def twin_command() -> list[str]:
     return [sys.executable, "-m", "twin"]
 
 
-def station_map_json(station: str | Path) -> str:
-    """`twin map STATION --format json`, as a user would run it."""
-    r = subprocess.run([*twin_command(), "map", str(station), "--format", "json"], capture_output=True, text=True,
-                       timeout=60)
-    if r.returncode != 0:
-        raise ServerStartError(f"`twin map {station} --format json` failed ({r.returncode}): {r.stderr.strip()}")
-    return r.stdout
-
-
 @contextlib.contextmanager
 def twin_server(station: str | Path, *, lockstep: bool = True, speed: float | None = None, host: str = LOOPBACK,
-                port: int | None = None, unit_id: int = 1, startup_timeout: float = 30.0,
+                port: int = 0, unit_id: int = 1, startup_timeout: float = 30.0,
                 extra_args: list[str] = ()) -> Iterator[TwinServer]:
-    """Start `twin serve STATION` on a free loopback port, wait until it accepts connections, stop it after.
+    """Start `twin serve STATION` on loopback, wait until it listens, and stop it afterwards.
 
+    port 0 (the default): the server binds a free port and says which (no race with other tests).
     lockstep: the server only steps when told (`sim.advance`): the same run gives the same result. Else it
     runs in real time, or at `speed` times real time.
     """
     station = Path(station)
-    map_json = station_map_json(station)
-    rmap = RegisterMap.from_json(map_json)
-    mode = ["--lockstep"] if lockstep else (["--speed", f"{speed:g}"] if speed else ["--realtime"])
-    attempts = 1 if port else 3
-    last_error = ""
-    for _ in range(attempts):
-        p = port or free_port(host)
-        with tempfile.TemporaryFile(mode="w+") as err:
-            proc = subprocess.Popen([*twin_command(), "serve", str(station), "--host", host, "--port", str(p),
-                                     "--unit-id", str(unit_id), *mode, *extra_args],
-                                    stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err)
-            try:
-                if _wait_listening(proc, host, p, startup_timeout):
-                    server = TwinServer(station, host, p, unit_id, lockstep, rmap, proc, map_json=map_json)
-                    try:
-                        yield server
-                    finally:
-                        _stop(proc)
-                        mf = getattr(server, "_map_file", None)
-                        if mf is not None:
-                            mf.unlink(missing_ok=True)
-                    return
-                _stop(proc)
-                err.seek(0)
-                last_error = err.read().strip()[-2000:]
-            except BaseException:
-                _stop(proc)
-                raise
-    raise ServerStartError(f"`twin serve {station}` did not start on {host}: {last_error or 'no output'}")
+    rmap = RegisterMap.from_station(station)
+    mode = ["--lockstep"] if lockstep else ["--realtime", *(["--speed", f"{speed:g}"] if speed else [])]
+    with tempfile.NamedTemporaryFile(mode="w+", prefix="twin-serve-", suffix=".log", delete=False) as log:
+        log_path = Path(log.name)
+        proc = subprocess.Popen([*twin_command(), "serve", str(station), "--host", host, "--port", str(port),
+                                 "--unit-id", str(unit_id), *mode, *extra_args],
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log)
+    server = None
+    try:
+        bound = _wait_listening(proc, log_path, startup_timeout)
+        if bound is None:
+            _stop(proc)
+            text = log_path.read_text(errors="replace").strip()
+            raise ServerStartError(f"`twin serve {station}` did not start: {text[-2000:] or 'no output'}")
+        server = TwinServer(station, host, bound, unit_id, lockstep, rmap, proc, map_json=json.dumps(rmap.as_list()))
+        server.log = log_path
+        yield server
+    finally:
+        _stop(proc)
+        log_path.unlink(missing_ok=True)
+        mf = getattr(server, "_map_file", None)
+        if mf is not None:
+            mf.unlink(missing_ok=True)
 
 
-def _wait_listening(proc: subprocess.Popen, host: str, port: int, timeout: float) -> bool:
+def _wait_listening(proc: subprocess.Popen, log: Path, timeout: float) -> int | None:
+    """The port from the server's "listening on HOST:PORT" line, or None if it exits or takes too long."""
     end = time.monotonic() + timeout
     while time.monotonic() < end:
+        for line in log.read_text(errors="replace").splitlines():
+            m = re.search(r"listening on \S+:(\d+)", line)
+            if m:
+                return int(m.group(1))
         if proc.poll() is not None:
-            return False
-        try:
-            with socket.create_connection((host, port), timeout=0.2):
-                return True
-        except OSError:
-            time.sleep(0.05)
-    return False
+            return None
+        time.sleep(0.02)
+    return None
 
 
 def _stop(proc: subprocess.Popen) -> None:

@@ -100,3 +100,17 @@ def test_with_fewer_forces_than_axes_all_axes_move_together_until_every_force_pa
 def test_a_sequence_without_an_end_of_travel_is_refused():
     with pytest.raises(ValueError, match="end_of_travel"):
         GripSequence(axes=("L2",), forces=("L2.force",), end_of_travel={"outside": 290.0})
+
+
+def test_a_prepare_request_moves_the_fingers_to_the_position_the_robot_asks_for():
+    from plc_client.grip_sequence import Handshake
+
+    seq = ring_sequence(handshake=Handshake(prepare_request="prepare", prepare_position="prepare_mm", state="grip_state"))
+    b = Bench(BENCH, seq=seq)
+    b.io.set("prepare_mm", 340.0)
+    b.io.set("prepare", True)
+    b.plc.scan()
+    assert b.out("grip_busy") and b.out("grip_state") == Phase.PREPARING
+    b.wait(Phase.IDLE)
+    assert b.io.get("L2.actual") == pytest.approx(340.0, abs=0.5) and not b.out("grip_busy")
+    b.twin.close()

@@ -43,6 +43,8 @@ def test_a_batch_read_takes_one_request_per_run_of_addresses(client):
 
 def test_a_write_takes_effect_at_the_next_steps_in_lockstep(client):
     client.write(L2=325.0, L3=325.0)
+    assert client.read("L2", "L3") == {"L2": 330.0, "L3": 330.0}  # reads show the last completed step
+    client.advance(1)
     assert client.read("L2", "L3") == {"L2": 325.0, "L3": 325.0}
     client.advance(100)
     assert client.get("L2.actual") == pytest.approx(325.0, abs=0.1)
@@ -76,8 +78,11 @@ def test_plc_read_prints_name_value_unit(server):
 def test_plc_write_sets_signals_in_engineering_units(server, client):
     r = plc(server, "write", "L4=327.5", "Active=1")
     assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == ["L4", "327.5", "mm", "Active", "1"]
+    client.advance(1)
     assert client.read("L4", "Active") == {"L4": 327.5, "Active": True}
     client.write(L4=330.0)
+    client.advance(1)
 
 
 def test_plc_watch_prints_one_line_per_sample_when_not_a_terminal(server):
@@ -98,6 +103,7 @@ def test_plc_out_of_range_is_exit_2_naming_the_range(server, client):
     r = plc(server, "write", "L3=300", "L2=450")
     assert r.returncode == 2
     assert r.stderr.strip() == "plc: error: signal 'L2': 450 mm is out of range: 0 to 441 mm"
+    client.advance(1)
     assert client.get("L3") == 330.0  # all or nothing: L3 was not written either
 
 
