@@ -14,8 +14,11 @@ is sent: an unknown name or an out-of-range value raises before the wire (see `p
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+import os
+import sys
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -93,7 +96,8 @@ class RegisterMap:
         from twin.modbus import register_map as rm
 
         try:
-            built = rm.build_map(station)
+            with _quiet_stdout():
+                built = rm.build_map(station)
         except (TwinError, rm.MapError) as exc:
             raise MapError(str(exc)) from None
         return cls(built.entries, {"station": built.station})
@@ -128,6 +132,27 @@ class RegisterMap:
         if not s.writable:
             raise NotWritableError(name)
         return _check(s, value)
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Silence native writes to stdout meanwhile (pybullet prints its build time when first imported)."""
+    try:
+        sys.stdout.flush()
+    except (AttributeError, ValueError, OSError):
+        pass
+    try:
+        saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
+    except OSError:
+        yield
+        return
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
 
 
 def _signal_from_dict(e: Any, where: str, i: int) -> Signal:
