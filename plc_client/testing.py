@@ -63,9 +63,10 @@ class TwinServer:
         """A new connected client (close it, or use it in a `with`)."""
         return TwinClient.connect(self.host, self.port, self.unit_id, map=self.map, timeout=timeout)
 
-    def io(self, client: TwinClient) -> ClientIO:
-        """The scan-cycle I/O for `client`: lockstep when the server is."""
-        return ClientIO(client, lockstep=self.lockstep)
+    def io(self, client: TwinClient, local: dict | None = None) -> ClientIO:
+        """The scan-cycle I/O for `client`: lockstep when the server is. `local`: signals the check holds
+        itself (e.g. the robot's handshake bits, when the check plays the robot)."""
+        return ClientIO(client, lockstep=self.lockstep, local=local)
 
     def plc_args(self) -> list[str]:
         """The global options of the `plc` command for this server (with a map file written once)."""

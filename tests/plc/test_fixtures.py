@@ -33,3 +33,16 @@ def test_user_logic_on_the_scan_cycle_against_the_server(plc_server, twin_client
     plc = ScanCycle(plc_server.io(twin_client), press, cycle=0.010)
     plc.run_until(lambda inputs, state: getattr(state, "done", False), timeout=10.0)
     assert twin_client.get("L2.force") >= 200.0
+
+
+@pytest.mark.parametrize("plc_station", [BENCH.with_name("ring_bench_empty")])  # the ring lies far away
+def test_the_documented_missed_grip_check(plc_server, twin_client):
+    from plc_client import Phase, ring_rig
+
+    seq = ring_rig.sequence()
+    io = plc_server.io(twin_client, local=seq.handshake_signals())
+    plc = ScanCycle(io, seq)
+    io.set("grip_request", True)  # the robot asks for an outside grip
+    plc.run_until(lambda i, s: s.phase in (Phase.HELD, Phase.FAULT_MISSED), timeout=10.0)
+    assert io.get("grip_fault") and not io.get("gripped")
+    assert twin_client.get("L2.actual") == pytest.approx(290.0, abs=0.5)  # stopped at the end of travel
