@@ -1,0 +1,26 @@
+"""Benchmarks: `python -m bench NAME [ARGS...]` (or `python3 tasks.py bench NAME`).
+
+Each benchmark is a module of this package with a `main(argv) -> int`; add yours to BENCHMARKS.
+"""
+from __future__ import annotations
+
+import importlib
+import sys
+
+BENCHMARKS = {
+    "core": "bench.core_step",  # simulation steps per second, grip-check cost vs target count
+    "modbus": "bench.modbus_latency",  # twin serve vs bare pymodbus: latency, throughput, late steps
+}
+
+
+def main(argv: list[str]) -> int:
+    if not argv or argv[0] in ("-h", "--help") or argv[0] not in BENCHMARKS:
+        print("usage: python -m bench NAME [ARGS...]   (NAME --help for its options)", file=sys.stderr)
+        for name, module in BENCHMARKS.items():
+            print(f"  {name:<8} {module}", file=sys.stderr)
+        return 0 if argv and argv[0] in ("-h", "--help") else 2
+    return importlib.import_module(BENCHMARKS[argv[0]]).main(argv[1:])
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
