@@ -1,0 +1,137 @@
+"""The runners (twin.pacing) and the bridge, in process, against a tiny stand-in twin (no physics)."""
+from __future__ import annotations
+
+import asyncio
+import struct
+import time
+
+from twin.core.errors import SignalRangeError
+from twin.core.signals import BOOL, FLOAT, INPUT, OUTPUT, SignalSpec
+from twin.modbus.bridge import TwinBridge
+from twin.modbus.register_map import build_register_map
+from twin.modbus.server import ModbusServer
+from twin.pacing import LockstepRunner, RealtimeRunner
+
+
+class StandIn:
+    """The Twin contract in memory: `x` follows the input `target`; `broken_at` makes a step fail."""
+
+    signals = (SignalSpec("go", INPUT, BOOL), SignalSpec("target", INPUT, FLOAT, "m", 0.0, 0.1),
+               SignalSpec("x", OUTPUT, FLOAT, "m", 0.0, 0.1), SignalSpec("at", OUTPUT, BOOL))
+
+    def __init__(self, broken_at: int | None = None):
+        self.values = {"go": False, "target": 0.0, "x": 0.0, "at": True}
+        self.step_count, self.dt, self.broken_at = 0, 0.012, broken_at
+
+    @property
+    def time(self) -> float:
+        return self.step_count * self.dt
+
+    def read(self, name):
+        return self.values[name]
+
+    def write(self, name, value):
+        if name == "target" and not 0 <= value <= 0.1:
+            raise SignalRangeError(name, value, 0, 0.1, "m")
+        self.values[name] = value
+
+    def step(self, n: int = 1):
+        for _ in range(n):
+            if self.step_count == self.broken_at:
+                raise RuntimeError("the physics engine gave up")
+            self.values["x"] = self.values["target"]
+            self.values["at"] = True
+            self.step_count += 1
+
+
+def test_the_realtime_runner_keeps_the_wall_clock_at_the_requested_speed():
+    async def run(speed: float) -> int:
+        steps = []
+        runner = RealtimeRunner(lambda: steps.append(1) or True, 0.01, speed)
+        task = asyncio.ensure_future(runner.run())
+        await asyncio.sleep(0.3)
+        runner.stop()
+        await task
+        return runner.steps, runner.late_steps
+
+    steps, late = asyncio.run(run(1.0))
+    assert 26 <= steps <= 32 and late < steps // 2  # loose: a loaded CI machine wakes sleepers late
+    steps, _ = asyncio.run(run(2.0))
+    assert 52 <= steps <= 63
+
+
+def test_a_step_slower_than_real_time_is_counted_late_and_the_runner_resynchronises():
+    async def run():
+        runner = RealtimeRunner(lambda: time.sleep(0.004) or True, 0.002, max_lag=0.02)
+        task = asyncio.ensure_future(runner.run())
+        await asyncio.sleep(0.2)
+        runner.stop()
+        await task
+        return runner
+
+    runner = asyncio.run(run())
+    assert runner.late_steps >= runner.steps - 1 and runner.resyncs >= 1
+
+
+def test_the_lockstep_runner_runs_exactly_the_steps_requested():
+    async def run():
+        count = []
+        runner = LockstepRunner(lambda: count.append(1) or True)
+        task = asyncio.ensure_future(runner.run())
+        await asyncio.sleep(0.05)
+        assert count == []
+        runner.request(7)
+        runner.request(3)
+        while runner.remaining:
+            await asyncio.sleep(0.001)
+        await asyncio.sleep(0.02)
+        runner.stop()
+        await task
+        return len(count)
+
+    assert asyncio.run(run()) == 10
+
+
+async def _rpc(reader, writer, pdu: bytes) -> bytes:
+    writer.write(struct.pack(">HHHB", 1, 0, len(pdu) + 1, 1) + pdu)
+    head = await reader.readexactly(7)
+    return await reader.readexactly(struct.unpack_from(">H", head, 4)[0] - 1)
+
+
+def test_a_failing_step_sets_the_fault_bit_freezes_the_outputs_and_writes_get_exception_04():
+    async def run():
+        twin = StandIn(broken_at=2)
+        rmap = build_register_map(twin.signals, "stand-in")
+        logs = []
+        bridge = TwinBridge(twin, rmap, log=logs.append)
+        runner = LockstepRunner(bridge.step)
+        bridge.runner = runner
+        server = ModbusServer(rmap, bridge, log=logs.append)
+        _, port = await server.start("127.0.0.1", 0)
+        task = asyncio.ensure_future(runner.run())
+        reader, writer = await asyncio.open_connection("127.0.0.1", port)
+        try:
+            target = rmap["target"].address
+            assert await _rpc(reader, writer, struct.pack(">BHH", 6, target, 5000)) == struct.pack(">BHH", 6, target, 5000)
+            assert await _rpc(reader, writer, struct.pack(">BHH", 6, 0, 5)) == struct.pack(">BHH", 6, 0, 5)
+            for _ in range(100):
+                if await _rpc(reader, writer, struct.pack(">BHH", 3, 0, 1)) == b"\x03\x02\x00\x00":
+                    break
+                await asyncio.sleep(0.01)
+            fault = await _rpc(reader, writer, struct.pack(">BHH", 2, rmap["fault"].address, 1))
+            step = await _rpc(reader, writer, struct.pack(">BHH", 4, rmap["sim.step"].address, 2))
+            x = await _rpc(reader, writer, struct.pack(">BHH", 4, rmap["x"].address, 1))
+            refused = await _rpc(reader, writer, struct.pack(">BHH", 6, target, 100))
+            return fault, step, x, refused, logs
+        finally:
+            writer.close()
+            runner.stop()
+            await server.close()
+            await asyncio.gather(task, return_exceptions=True)
+
+    fault, step, x, refused, logs = asyncio.run(run())
+    assert fault == b"\x02\x01\x01"
+    assert step == b"\x04\x04" + struct.pack(">I", 2)  # two steps done, the third failed
+    assert x == b"\x04\x02" + struct.pack(">H", 5000)  # 50.00 mm: the last completed step
+    assert refused == b"\x86\x04"
+    assert any("simulation fault at step 2" in line and "gave up" in line for line in logs)
