@@ -263,6 +263,7 @@ class Interpreter:
             yield from self.guarded(s, f)
 
     def guarded(self, s: n.Stmt, f: Frame):
+        quick_retries = 0
         while True:
             mark = self.suspensions
             try:
@@ -276,8 +277,14 @@ class Interpreter:
                 action = yield from self.handler(f, err)
                 if action == "trynext":
                     return
-                if self.suspensions == mark:  # RETRY without time passing: one step per retry
-                    yield Wait("step", what="RETRY")
+                if self.suspensions == mark:
+                    # RETRY is immediate, but a statement retried again and again without time
+                    # passing costs one step per retry, so a RETRY loop cannot hang the cell.
+                    quick_retries += 1
+                    if quick_retries > 1:
+                        yield Wait("step", what="RETRY")
+                else:
+                    quick_retries = 0
 
     def handler(self, f: Frame, err: ExecError):
         self.errno = float(err.errno)

@@ -1,0 +1,172 @@
+"""The RAPID controller bound to a twin: the station's `[controller]` becomes the cell's robot controller.
+
+Two small adapters, one per side of the controller:
+
+- `TwinHost` is the controller's `Host`. Its I/O signals are the station's `[[controller.io]]`:
+  an output with `drives` writes `scale * value + offset` to a twin input at once (`aoAxis1` in mm
+  drives `L2` in m, as RobotStudio's expression blocks do); an input with `source` reads a twin output
+  live, `(twin value - offset) / scale`; the others live in the controller's memory. Motions drive
+  the station's robot through the twin's motion API and are done when the robot is in position.
+- `ControllerDevice` is the twin's `Device`: it ticks the controller at the start of every simulation
+  step (before the gripper and the robot act, so a `SetAO` takes effect in the same step), and adds the
+  controller's signals to the twin's signal table, so the Modbus server publishes them. Memory signals
+  are writable from outside (like RobotStudio's I/O simulator); wired ones are read-only mirrors.
+
+`attach_controller(twin)` does the wiring for a twin whose station has a `[controller]`.
+"""
+from __future__ import annotations
+
+import math
+from typing import Callable, Sequence
+
+from twin.core.errors import MotionError, TwinError
+from twin.core.signals import BOOL, FLOAT, INPUT, INT, OUTPUT, SignalSpec
+from twin.core.station import ControllerSpec
+
+from .builtins import ERRORS
+from .controller import Controller, load_program
+from .errors import ExecError
+from .host import MotionRequest, SignalInfo
+from .values import Record, record
+
+SIGNAL_TYPE = {"DI": BOOL, "DO": BOOL, "AI": FLOAT, "AO": FLOAT, "GI": INT, "GO": INT}
+
+
+class HostError(ExecError):
+    """A request the cell refuses (a setpoint out of range, an unreachable target)."""
+
+    def __init__(self, message: str, errname: str):
+        super().__init__(f"{message} ({errname})", None, ERRORS.get(errname, 0), errname)
+
+
+def _pose_of(target: Record) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """A robtarget or pose (mm, quaternion q1..q4 with q1 = w) as a position in m and an xyzw quaternion."""
+    trans, rot = target.fields["trans"], target.fields["rot"]
+    x, y, z = (float(v) / 1000.0 for v in trans.values())
+    w, qx, qy, qz = (float(v) for v in rot.values())
+    norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz) or 1.0
+    return (x, y, z), (qx / norm, qy / norm, qz / norm, w / norm)
+
+
+class TwinHost:
+    """The controller's view of the cell: wired signals, memory signals and the robot."""
+
+    def __init__(self, twin, spec: ControllerSpec):
+        self.twin, self.spec = twin, spec
+        self.config = [SignalInfo(s.name, s.type) for s in spec.io]
+        self.io = {s.name: s for s in spec.io}
+        self.memory: dict[str, float] = {s.name: 0.0 for s in spec.io if not (s.drives or s.source)}
+        self.outputs: dict[str, float] = {s.name: 0.0 for s in spec.io if s.drives}
+        self.printed: list[str] = []
+        self._motion = 0
+
+    # -- signals --------------------------------------------------------------------------------------
+    def signals(self) -> Sequence[SignalInfo]:
+        return self.config
+
+    def read_signal(self, name: str) -> float:
+        sig = self.io[name]
+        if sig.source:
+            value = self.twin.read(sig.source)
+            if isinstance(value, str):  # an enum output (GrippedPart): its index, 0 for none
+                value = self.twin.spec(sig.source).choices.index(value)
+            return (float(value) - sig.offset) / sig.scale
+        if sig.drives:
+            return self.outputs[name]
+        return self.memory[name]
+
+    def write_signal(self, name: str, value: float) -> None:
+        sig = self.io[name]
+        if sig.drives:
+            try:
+                self.twin.write(sig.drives, sig.scale * value + sig.offset)
+            except TwinError as exc:
+                errname = {"AO": "ERR_AO_LIM", "GO": "ERR_GO_LIM"}.get(sig.type, "ERR_INVALID_VALUE")
+                raise HostError(f"{name} = {value:g} drives {exc}", errname) from None
+            self.outputs[name] = float(value)
+        else:
+            self.memory[name] = float(value)
+
+    # -- robot ----------------------------------------------------------------------------------------
+    def start_motion(self, request: MotionRequest) -> object:
+        twin = self.twin
+        speed = request.speed.fields
+        v_tcp = float(speed["v_tcp"]) / 1000.0
+        v_ori = math.radians(float(speed["v_ori"]))
+        name = request.target_name or request.instr
+        try:
+            if request.instr == "MoveAbsJ":
+                q = [math.radians(float(v)) for v in request.target.fields["robax"].values()]
+                twin.move("MoveAbsJ", q, v_tcp, v_ori=v_ori, name=name)
+            else:
+                wobj = request.wobj.fields
+                target = self._in_world(_pose_of(request.target), wobj)
+                via = self._in_world(_pose_of(request.via), wobj) if request.via is not None else None
+                twin.move(request.instr, target, v_tcp, v_ori=v_ori, via=via, name=name)
+        except MotionError as exc:
+            raise HostError(str(exc), "ERR_ROBLIMIT") from None
+        self._motion += 1
+        return self._motion
+
+    def _in_world(self, pose, wobj: dict):
+        from twin.core.geometry import Pose
+
+        frame = Pose.identity()
+        for key in ("uframe", "oframe"):
+            frame = frame * Pose(*_pose_of(wobj[key]))
+        return frame * Pose(*pose)
+
+    def motion_done(self, handle: object) -> bool:
+        return handle != self._motion or not self.twin.robot_busy
+
+    def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
+        pose = self.twin.tcp_pose()
+        x, y, z = (float(v) * 1000.0 for v in pose.position)
+        qx, qy, qz, w = (float(v) for v in pose.orientation)
+        return record("robtarget", [x, y, z], [w, qx, qy, qz], [0, 0, 0, 0], [9e9] * 6)
+
+    def current_jointtarget(self) -> Record:
+        q = [math.degrees(float(v)) for v in self.twin.robot_q]
+        return record("jointtarget", q, [9e9] * 6)
+
+    def tp_write(self, text: str) -> None:
+        self.printed.append(text)
+
+
+class ControllerDevice:
+    """Steps the controller with the twin and publishes the controller's signals in the signal table."""
+
+    def __init__(self, host: TwinHost, controller: Controller):
+        self.host, self.controller = host, controller
+        specs = []
+        for sig in host.spec.io:
+            wired = sig.drives or sig.source
+            what = (f"drives {sig.drives}" if sig.drives else f"reads {sig.source}" if sig.source else "controller memory")
+            specs.append(SignalSpec(sig.name, OUTPUT if wired else INPUT, SIGNAL_TYPE[sig.type],
+                                    description=f"robot controller {sig.type} {sig.name} ({what})", group="controller"))
+        self.signals = tuple(specs)
+
+    def read(self, name: str):
+        value = self.host.read_signal(name)
+        kind = SIGNAL_TYPE[self.host.io[name].type]
+        return bool(value) if kind == BOOL else int(value) if kind == INT else value
+
+    def write(self, name: str, value) -> None:
+        self.host.memory[name] = float(value)
+
+    def before_step(self, twin) -> None:
+        self.controller.tick(twin.time)
+
+    def after_step(self, twin) -> None:
+        pass
+
+
+def attach_controller(twin, on_event: Callable[[dict], None] | None = None, autostart: bool = True) -> Controller:
+    """Load the station's RAPID program and make it the twin's robot controller."""
+    spec = twin.station.controller
+    if spec is None:
+        raise TwinError(f"station {twin.station.name!r} has no [controller]")
+    host = TwinHost(twin, spec)
+    controller = Controller(load_program(spec.program), host, entry=spec.entry, on_event=on_event, autostart=autostart)
+    twin.add_device(ControllerDevice(host, controller))
+    return controller
