@@ -200,3 +200,25 @@ def test_every_entry_of_the_exported_json_map_reads_back_at_its_address_with_its
             want = min(max(want, lo), hi)
             assert got[e["name"]] == pytest.approx(want, abs=0.5 + 1e-9), e["name"]
         assert twin.read("doGripped") and got["doGripped"] == 1 and got["GrippedPart"] == 1
+
+
+def test_twin_map_prints_csv_and_markdown_for_any_station():
+    from modbus_helpers import SMART_GRIPPER
+
+    md = subprocess.run([sys.executable, "-m", "twin", "map", str(SMART_GRIPPER), "--format", "md"],
+                        capture_output=True, text=True, cwd=ROOT, timeout=60)
+    assert md.returncode == 0, md.stderr
+    assert "| 16 | 40017 | `jaw_left` | uint16 | mm | 0.01 | 0 .. 25 | rw |" in md.stdout
+    assert "high word first" in md.stdout
+    out = subprocess.run([sys.executable, "-m", "twin", "map", str(SMART_GRIPPER), "--format", "csv"],
+                         capture_output=True, text=True, cwd=ROOT, timeout=60)
+    assert out.returncode == 0 and out.stdout.startswith("name,table,address,count,type,scale,unit,min,max,access")
+
+
+def test_a_wrong_station_or_a_busy_port_is_one_line_on_stderr_and_exit_2(lockstep_server, tmp_path):
+    r = subprocess.run([sys.executable, "-m", "twin", "serve", str(tmp_path / "nowhere")], capture_output=True,
+                       text=True, cwd=ROOT, timeout=60)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    r = subprocess.run([sys.executable, "-m", "twin", "serve", str(RING_BENCH), "--port", str(lockstep_server.port)],
+                       capture_output=True, text=True, cwd=ROOT, timeout=60)
+    assert r.returncode == 2 and "cannot listen on" in r.stderr and "Traceback" not in r.stderr
