@@ -36,6 +36,7 @@ class TwinBridge:
         self._sizes = {t: rmap.size(t) for t in (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)}
         self._entries = {t: rmap.table(t) for t in self._sizes}
         self._advance = rmap[ADVANCE] if ADVANCE in rmap else None
+        self.live_addresses = frozenset({self._advance.address} if self._advance is not None else ())
         self.images: Images = Images(b"", b"", b"", b"")
         self.publish()
 

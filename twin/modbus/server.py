@@ -82,6 +82,8 @@ class Backend(Protocol):
         """Queue writes (entry, value in SI units) for the next step, all or nothing.
         Returns 0, or a Modbus exception code (nothing queued)."""
 
+    live_addresses: frozenset[int]  # holding registers whose value is live (read through live_holding)
+
     def live_holding(self, address: int) -> int | None:
         """A holding register whose value is live rather than from the last step (e.g. sim.advance)."""
 
@@ -112,15 +114,14 @@ class _Table:
         return self.readable(address, count) and self.starts[address] == 1 and self.ends[address + count] == 1
 
 
+_ASCII_BITS = bytes.maketrans(b"\x00\x01", b"01")
+
+
 def _pack_bits(bits: bytes) -> bytes:
-    out = bytearray((len(bits) + 7) // 8)
-    for i in range(0, len(bits), 8):
-        v = 0
-        for j, b in enumerate(bits[i:i + 8]):
-            if b:
-                v |= 1 << j
-        out[i >> 3] = v
-    return bytes(out)
+    """Bytes of 0/1 -> Modbus bit packing (first bit in the low bit of the first byte)."""
+    if not bits:
+        return b""
+    return int(bits.translate(_ASCII_BITS)[::-1], 2).to_bytes((len(bits) + 7) // 8, "little")
 
 
 class ModbusServer:
@@ -198,14 +199,14 @@ class ModbusServer:
         if table == INPUT_REGISTER:
             return images.input_registers[2 * address:2 * (address + count)]
         data = images.holding[2 * address:2 * (address + count)]
-        live = self.backend.live_holding
         patched = None
-        for a in range(address, address + count):
-            v = live(a)
-            if v is not None:
-                if patched is None:
-                    patched = bytearray(data)
-                struct.pack_into(">H", patched, 2 * (a - address), v)
+        for a in self.backend.live_addresses:
+            if address <= a < address + count:
+                v = self.backend.live_holding(a)
+                if v is not None:
+                    if patched is None:
+                        patched = bytearray(data)
+                    struct.pack_into(">H", patched, 2 * (a - address), v)
         return data if patched is None else bytes(patched)
 
     def _write(self, table: str, address: int, words: Sequence[int]) -> int:
