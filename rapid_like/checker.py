@@ -27,6 +27,7 @@ class Sym:
     type: str | None
     storage: str = "VAR"  # VAR, PERS, CONST
     signal: SignalInfo | None = None
+    name: str = ""  # as declared
 
 
 def check(module: n.Module, signals: dict[str, SignalInfo] | None = None) -> None:
@@ -49,16 +50,22 @@ class Checker:
     def all_names(self, scope: dict[str, Sym]) -> list[str]:
         return list(scope) + list(self.globals) + list(self.signals) + list(self.routines)
 
+    def spelling(self, key: str, scope: dict[str, Sym]) -> str:
+        """A name as it was declared (hints show `Axis1`, not `axis1`)."""
+        for table in (scope, self.globals):
+            if key in table and table[key].name:
+                return table[key].name
+        if key in self.signals:
+            return self.signals[key].name
+        if key in self.routines:
+            return self.routines[key].name
+        return key
+
     def undefined(self, name: str, span: Span, scope: dict[str, Sym], what: str = "") -> CheckError:
         close = difflib.get_close_matches(name.lower(), self.all_names(scope), n=1)
         hint = ""
         if close:
-            real = close[0]
-            if real in self.signals:
-                real = self.signals[real].name
-            elif real in self.routines:
-                real = self.routines[real].name
-            hint = f" (did you mean {real}?)"
+            hint = f" (did you mean {self.spelling(close[0], scope)}?)"
         return self.err(f"undefined name '{name}'{what}: it is not declared data, a routine or a configured "
                         f"I/O signal{hint}", span)
 
@@ -102,7 +109,7 @@ class Checker:
                 raise self.err(f"{d.name} is already a configured I/O signal", d.span)
             if d.init is not None:
                 self.expect_type(d.init, d.type, {})
-            self.globals[d.key] = Sym("data", d.type, d.storage)
+            self.globals[d.key] = Sym("data", d.type, d.storage, name=d.name)
         for r in self.module.routines:
             self.routine(r)
 
@@ -119,7 +126,7 @@ class Checker:
                 if q.type in SIGNAL_TYPES:
                     scope[q.key] = Sym("signal", "num", "CONST", SignalInfo(q.name, SIGNAL_TYPES[q.type]))
                 else:
-                    scope[q.key] = Sym(kind, q.type, "CONST" if kind == "switch" else "VAR")
+                    scope[q.key] = Sym(kind, q.type, "CONST" if kind == "switch" else "VAR", name=q.name)
         self.current = r
         self.block(r.body, scope, in_handler=False)
         if r.error_handler is not None:
@@ -138,7 +145,7 @@ class Checker:
                 raise self.err(f"{d.name} is declared twice in {self.current.name}", d.span)
             if d.init is not None:
                 self.expect_type(d.init, d.type, scope)
-            scope[d.key] = Sym("data", d.type, d.storage)
+            scope[d.key] = Sym("data", d.type, d.storage, name=d.name)
         elif isinstance(s, n.Assign):
             ttype = self.assign_target(s.target, scope)
             self.expect_type(s.value, ttype, scope)
@@ -160,7 +167,7 @@ class Checker:
             if s.var.lower() in scope:
                 raise self.err(f"the FOR variable {s.var} hides a routine variable of the same name", s.var_span)
             inner = dict(scope)
-            inner[s.var.lower()] = Sym("loop", "num", "CONST")
+            inner[s.var.lower()] = Sym("loop", "num", "CONST", name=s.var)
             self.block(s.body, inner, h)
             for k, v in inner.items():  # declarations inside the loop body stay visible after it
                 if k != s.var.lower() and k not in scope:
