@@ -1,0 +1,204 @@
+"""Forward and inverse kinematics of a robot arm, on a private pybullet connection.
+
+`ArmKinematics` loads only the arm's URDF into its own DIRECT connection, so solving IK or FK never
+disturbs the physics world. The TCP is the flange link's frame times the tool pose (flange -> TCP).
+
+IK uses pybullet's `calculateInverseKinematics` (damped least squares with joint limits in the null
+space) on the flange link, restarted from its own result until the flange is within 0.1 mm and 0.01
+degrees of the target; a damped-least-squares polish on pybullet's Jacobian finishes the last bits.
+Every query resets the joint states first, so the result depends only on the inputs: the same inputs
+give the same outputs, bit for bit.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable, Sequence
+
+import numpy as np
+import pybullet
+from pybullet_utils.bullet_client import BulletClient
+
+from .errors import MotionError
+from .geometry import Pose, quat_conj, quat_mul
+from .world import quiet_native_stdout
+
+ARM_JOINTS = ("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6")
+
+#: IK converges when the TCP is this close (m, rad) ...
+IK_TOL_POS = 1e-4
+IK_TOL_ORI = math.radians(0.01)
+#: ... and fails with MotionError if it cannot get this close.
+IK_FAIL_POS = 1e-3
+IK_FAIL_ORI = math.radians(0.1)
+
+
+@dataclass(frozen=True)
+class JointLimit:
+    """One arm axis as its URDF declares it: range (rad), max speed (rad/s), max effort (N m)."""
+
+    name: str
+    lower: float
+    upper: float
+    velocity: float
+    effort: float
+
+    def contains(self, q: float, margin: float = 1e-9) -> bool:
+        return self.lower - margin <= q <= self.upper + margin
+
+
+class ArmKinematics:
+    """FK/IK of one arm: `fk(q) -> Pose` (TCP in the world), `ik(pose, seed_q, target_name) -> q`.
+
+    `base_position`/`base_orientation_xyzw` place the arm's base in the world (as in the physics world),
+    `tool` is the TCP in the flange frame. `limits` lists the arm's axes (JointLimit) in order.
+    """
+
+    def __init__(self, urdf_path: str | Path, base_position: Iterable[float] = (0.0, 0.0, 0.0),
+                 base_orientation_xyzw: Iterable[float] = (0.0, 0.0, 0.0, 1.0), flange_link: str = "flange",
+                 tool: Pose | None = None, joint_names: Sequence[str] = ARM_JOINTS):
+        self.urdf_path = Path(urdf_path)
+        self.base = Pose(base_position, base_orientation_xyzw)
+        self.tool = tool if tool is not None else Pose.identity()
+        self._tool_inv = self.tool.inverse()
+        with quiet_native_stdout():
+            self.client = BulletClient(connection_mode=pybullet.DIRECT)
+            self.body = self.client.loadURDF(str(self.urdf_path), self.base.position.tolist(),
+                                             self.base.orientation.tolist(), useFixedBase=True,
+                                             flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+        c = self.client
+        by_name: dict[str, int] = {}
+        links: dict[str, int] = {}
+        movable: list[int] = []
+        for j in range(c.getNumJoints(self.body)):
+            info = c.getJointInfo(self.body, j)
+            by_name[info[1].decode()] = j
+            links[info[12].decode()] = j
+            if info[2] != pybullet.JOINT_FIXED:
+                movable.append(j)
+        if flange_link not in links:
+            raise MotionError(flange_link, f"{self.urdf_path.name} has no link {flange_link!r}")
+        missing = [n for n in joint_names if n not in by_name]
+        if missing:
+            raise MotionError(missing[0], f"{self.urdf_path.name} has no joint {missing[0]!r}")
+        self.joint_names = tuple(joint_names)
+        self.joints = [by_name[n] for n in joint_names]
+        if movable != self.joints:
+            raise MotionError(flange_link, f"{self.urdf_path.name}: the movable joints must be exactly {self.joint_names} in order")
+        self.flange = links[flange_link]
+        self.limits = tuple(JointLimit(n, *(float(v) for v in c.getJointInfo(self.body, j)[8:12]))
+                            for n, j in zip(self.joint_names, self.joints))
+        self.lower = np.array([lim.lower for lim in self.limits])
+        self.upper = np.array([lim.upper for lim in self.limits])
+        self.max_velocity = np.array([lim.velocity for lim in self.limits])
+        self.n = len(self.joints)
+
+    def close(self) -> None:
+        try:
+            self.client.disconnect()
+        except pybullet.error:
+            pass
+
+    # -- forward kinematics ------------------------------------------------------------------------
+    def _set(self, q: np.ndarray) -> None:
+        for j, v in zip(self.joints, q):
+            self.client.resetJointState(self.body, j, float(v), 0.0)
+
+    def _flange(self) -> Pose:
+        s = self.client.getLinkState(self.body, self.flange, computeForwardKinematics=True)
+        return Pose(s[4], s[5])
+
+    def flange_pose(self, q: Iterable[float]) -> Pose:
+        self._set(self._as_q(q))
+        return self._flange()
+
+    def fk(self, q: Iterable[float]) -> Pose:
+        """The TCP pose (flange x tool) in the world for joint positions q (rad)."""
+        return self.flange_pose(q) * self.tool
+
+    def _as_q(self, q: Iterable[float]) -> np.ndarray:
+        q = np.array([float(v) for v in q])
+        if q.shape != (self.n,):
+            raise ValueError(f"expected {self.n} joint values, got {q.shape[0] if q.ndim else 0}")
+        return q
+
+    # -- inverse kinematics ------------------------------------------------------------------------
+    def check_limits(self, q: Iterable[float], target_name: str) -> None:
+        """MotionError naming the target when a joint value is outside its range."""
+        for lim, v in zip(self.limits, self._as_q(q)):
+            if not lim.contains(float(v)):
+                raise MotionError(target_name, f"would need {lim.name} beyond its limit ({math.degrees(v):.1f} deg, "
+                                               f"range {math.degrees(lim.lower):.0f} to {math.degrees(lim.upper):.0f} deg)")
+
+    def ik(self, pose: Pose, seed_q: Iterable[float], target_name: str = "target", *,
+           max_iterations: int = 40) -> np.ndarray:
+        """Joint positions that put the TCP at `pose`, near `seed_q`. Raises MotionError naming the target."""
+        seed = np.clip(self._as_q(seed_q), self.lower, self.upper)
+        goal = pose * self._tool_inv
+        q, err_p, err_o = self._solve(goal, seed, self.lower, self.upper, max_iterations)
+        if err_p <= IK_FAIL_POS and err_o <= IK_FAIL_ORI:
+            return q
+        # Out of reach, or only beyond a joint limit? Solve again without the limits to tell.
+        wide = np.full(self.n, 4.0 * math.pi)
+        q_free, fp, fo = self._solve(goal, seed, -wide, wide, max_iterations)
+        if fp <= IK_FAIL_POS and fo <= IK_FAIL_ORI:
+            self.check_limits(q_free, target_name)
+        if err_p > IK_FAIL_POS:
+            raise MotionError(target_name, f"cannot be reached: closest is {err_p * 1000:.1f} mm away")
+        raise MotionError(target_name, f"cannot be reached: closest orientation is {math.degrees(err_o):.2f} deg away")
+
+    def _error(self, goal: Pose) -> tuple[float, float, Pose]:
+        f = self._flange()
+        return f.distance(goal), f.angle(goal), f
+
+    def _solve(self, goal: Pose, seed: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+               max_iterations: int) -> tuple[np.ndarray, float, float]:
+        c = self.client
+        ranges = upper - lower
+        q = seed.copy()
+        self._set(q)
+        best_q, best_p, best_o = q.copy(), *self._error(goal)[:2]
+        pos, orn = goal.position.tolist(), goal.orientation.tolist()
+        for _ in range(max_iterations):
+            if best_p < IK_TOL_POS and best_o < IK_TOL_ORI:
+                break
+            sol = c.calculateInverseKinematics(self.body, self.flange, pos, orn, lowerLimits=lower.tolist(),
+                                               upperLimits=upper.tolist(), jointRanges=ranges.tolist(),
+                                               restPoses=q.tolist(), maxNumIterations=20, residualThreshold=1e-6)
+            q_new = np.clip(np.array(sol[:self.n]), lower, upper)
+            q_new = self._polish(goal, q_new, lower, upper, 3)
+            self._set(q_new)
+            p, o, _ = self._error(goal)
+            q = q_new
+            if p + o < best_p + best_o:
+                best_q, best_p, best_o = q.copy(), p, o
+        if not (best_p < IK_TOL_POS and best_o < IK_TOL_ORI):
+            q = self._polish(goal, best_q, lower, upper, 20)
+            self._set(q)
+            p, o, _ = self._error(goal)
+            if p + o < best_p + best_o:
+                best_q, best_p, best_o = q, p, o
+        return best_q, best_p, best_o
+
+    def _polish(self, goal: Pose, q: np.ndarray, lower: np.ndarray, upper: np.ndarray, steps: int) -> np.ndarray:
+        """Damped least squares on pybullet's Jacobian of the flange (full 6-D error)."""
+        c = self.client
+        zeros = [0.0] * self.n
+        for _ in range(steps):
+            self._set(q)
+            p, o, f = self._error(goal)
+            if p < IK_TOL_POS * 0.1 and o < IK_TOL_ORI * 0.1:
+                break
+            dq_rot = quat_mul(goal.orientation, quat_conj(f.orientation))
+            if dq_rot[3] < 0:
+                dq_rot = -dq_rot
+            s = math.sqrt(float(dq_rot[:3] @ dq_rot[:3]))
+            w = (2.0 * math.atan2(s, dq_rot[3]) / s) * dq_rot[:3] if s > 1e-12 else 2.0 * dq_rot[:3]
+            err = np.concatenate([goal.position - f.position, w])
+            jl, ja = c.calculateJacobian(self.body, self.flange, [0.0, 0.0, 0.0], q.tolist(), zeros, zeros)
+            jac = np.vstack([np.array(jl), np.array(ja)])
+            lam2 = 1e-6
+            dq = jac.T @ np.linalg.solve(jac @ jac.T + lam2 * np.eye(6), err)
+            q = np.clip(q + dq, lower, upper)
+        return q

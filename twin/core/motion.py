@@ -1,0 +1,294 @@
+"""Robot motions as pure functions of time: MoveJ, MoveL, MoveC and MoveAbsJ trajectories.
+
+A `Trajectory` is planned completely when it is built: Cartesian moves (MoveL, MoveC) solve IK at
+sample points every 5 mm (and every 0.5 degrees of reorientation) along the path, each seeded by the
+previous solution, so a path through an unreachable point, past a joint limit or through a
+configuration flip raises `MotionError` naming the target before the robot moves. Executing it is then
+only a lookup: `q(t)` and `qd(t)` for t in seconds since the motion started.
+
+Timing: a path is followed at constant speed with a smooth ramp at both ends (velocity rises as a half
+cosine over `Speed.ramp` seconds, shortened for short moves). The cruise time is the longest of
+path length / v_tcp, reorientation angle / v_ori and, for every axis, what its speed limit
+(`JointLimit.velocity` x `Speed.joint_fraction`) allows: like a real controller, a move that would
+need an axis faster than it can go is slowed down, not refused.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Iterable, Sequence
+
+import numpy as np
+
+from .errors import MotionError
+from .geometry import Pose, slerp
+from .kinematics import ArmKinematics, JointLimit
+
+#: Cartesian paths are solved at least every SAMPLE_STEP m and SAMPLE_ANGLE rad.
+SAMPLE_STEP = 0.005
+SAMPLE_ANGLE = math.radians(0.5)
+#: Between two neighbouring samples no axis may jump more than this (a configuration flip).
+MAX_JOINT_JUMP = math.radians(5.0)
+
+
+@dataclass(frozen=True)
+class Speed:
+    """How fast a motion may go.
+
+    v_tcp:          TCP speed along the path, m/s (RAPID speeddata v_tcp / 1000).
+    v_ori:          reorientation speed of the tool, rad/s (RAPID v_ori; v1000 has 500 deg/s).
+    joint_fraction: fraction of each axis's maximum speed (URDF `velocity`) a move may use, 0 to 1.
+    ramp:           time to reach full speed from standstill, s (and to stop).
+    """
+
+    v_tcp: float = 1.0
+    v_ori: float = math.radians(500.0)
+    joint_fraction: float = 1.0
+    ramp: float = 0.2
+
+    def check(self, name: str) -> None:
+        for field in ("v_tcp", "v_ori", "joint_fraction"):
+            v = getattr(self, field)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise MotionError(name, f"speed {field} must be a positive number, not {v!r}")
+        if self.joint_fraction > 1.0:
+            raise MotionError(name, f"speed joint_fraction must be at most 1, not {self.joint_fraction!r}")
+        if not (math.isfinite(self.ramp) and self.ramp >= 0):
+            raise MotionError(name, f"speed ramp must be a non-negative number of seconds, not {self.ramp!r}")
+
+
+class Profile:
+    """Path parameter s(t) from 0 to 1: half-cosine ramp up, constant speed 1/cruise, ramp down."""
+
+    def __init__(self, cruise: float, ramp: float):
+        self.cruise = float(cruise)
+        self.ramp = min(float(ramp), self.cruise)
+        self.duration = self.cruise + self.ramp
+        self.rate = 1.0 / self.cruise if self.cruise > 0 else 0.0
+
+    def _up(self, t: float) -> tuple[float, float]:
+        ta, v = self.ramp, self.rate
+        if ta <= 0:
+            return v * t, v
+        return v * (t / 2 - ta / (2 * math.pi) * math.sin(math.pi * t / ta)), v * (1 - math.cos(math.pi * t / ta)) / 2
+
+    def s(self, t: float) -> tuple[float, float]:
+        """(s, ds/dt) at time t."""
+        if self.cruise <= 0 or t >= self.duration:
+            return 1.0, 0.0
+        if t <= 0:
+            return 0.0, 0.0
+        ta = self.ramp
+        if t < ta:
+            return self._up(t)
+        if t <= self.duration - ta:
+            return self.rate * (ta / 2 + (t - ta)), self.rate
+        s, v = self._up(self.duration - t)
+        return 1.0 - s, v
+
+
+class Trajectory:
+    """Joint positions as a function of time since the motion started.
+
+    `q(t)`, `qd(t)` (rad, rad/s), `done(t)`, `duration` (s), `q_start`, `q_end`, `name` (the target),
+    `kind` (MoveJ, MoveL, MoveC, MoveAbsJ). Cartesian moves also keep `path(s) -> Pose`, the planned TCP
+    pose at path parameter s (0 to 1), and `tcp_path_length` (m).
+    """
+
+    def __init__(self, kind: str, name: str, knots: np.ndarray, profile: Profile,
+                 path: Callable[[float], Pose] | None = None, tcp_path_length: float = 0.0):
+        self.kind, self.name = kind, name
+        self._knots = np.array(knots, dtype=float)  # shape (n+1, axes): q at s = i/n
+        self._n = len(self._knots) - 1
+        self.profile = profile
+        self.duration = profile.duration
+        self.path = path
+        self.tcp_path_length = tcp_path_length
+
+    @property
+    def q_start(self) -> np.ndarray:
+        return self._knots[0].copy()
+
+    @property
+    def q_end(self) -> np.ndarray:
+        return self._knots[-1].copy()
+
+    def _at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        if self._n == 0:
+            return self._knots[0].copy(), np.zeros(self._knots.shape[1])
+        x = s * self._n
+        i = min(int(x), self._n - 1)
+        f = x - i
+        a, b = self._knots[i], self._knots[i + 1]
+        return a + f * (b - a), (b - a) * self._n
+
+    def q(self, t: float) -> np.ndarray:
+        s, _ = self.profile.s(t)
+        return self._at(s)[0]
+
+    def qd(self, t: float) -> np.ndarray:
+        s, v = self.profile.s(t)
+        return self._at(s)[1] * v
+
+    def done(self, t: float) -> bool:
+        return t >= self.duration
+
+    def __repr__(self) -> str:
+        return f"Trajectory({self.kind} {self.name!r}, {self.duration:.3f} s)"
+
+
+# -- helpers -----------------------------------------------------------------------------------------
+def _joint_cruise(knots: np.ndarray, limits: Sequence[JointLimit], speed: Speed) -> float:
+    """Shortest cruise time in which no axis exceeds its speed limit (knots are uniform in s)."""
+    if len(knots) < 2:
+        return 0.0
+    vmax = np.array([lim.velocity for lim in limits]) * speed.joint_fraction
+    dq_ds = np.abs(np.diff(knots, axis=0)) * (len(knots) - 1)
+    return float(np.max(dq_ds.max(axis=0) / vmax))
+
+
+def _as_q(q: Iterable[float], n: int, name: str, what: str) -> np.ndarray:
+    arr = np.array([float(v) for v in q])
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise MotionError(name, f"{what} needs {n} finite joint values")
+    return arr
+
+
+def _check_limits(q: np.ndarray, limits: Sequence[JointLimit], name: str) -> None:
+    for lim, v in zip(limits, q):
+        if not lim.contains(float(v)):
+            raise MotionError(name, f"would need {lim.name} beyond its limit ({math.degrees(v):.1f} deg, "
+                                    f"range {math.degrees(lim.lower):.0f} to {math.degrees(lim.upper):.0f} deg)")
+
+
+def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callable[[float], Pose], length: float,
+               angle: float, speed: Speed, name: str) -> Trajectory:
+    """Solve IK along path(s), s in [0, 1], seeded sample to sample, and time it."""
+    n = max(1, math.ceil(length / SAMPLE_STEP), math.ceil(angle / SAMPLE_ANGLE))
+    knots = [q_start]
+    q_prev = q_start
+    for i in range(1, n + 1):
+        s = i / n
+        q = kin.ik(path(s), q_prev, name)
+        jump = np.abs(q - q_prev)
+        if np.max(jump) > MAX_JOINT_JUMP:
+            q = _bridge(kin, path, (i - 1) / n, s, q_prev, name)
+        knots.append(q)
+        q_prev = q
+    knots_arr = np.array(knots)
+    cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots_arr, kin.limits, speed))
+    return Trajectory(kind, name, knots_arr, Profile(cruise, speed.ramp), path, length)
+
+
+def _bridge(kin: ArmKinematics, path: Callable[[float], Pose], s0: float, s1: float, q0: np.ndarray, name: str,
+            depth: int = 0) -> np.ndarray:
+    """A jump between two samples: solve the midpoint; raise if the arm really flips configuration."""
+    sm = (s0 + s1) / 2
+    qm = kin.ik(path(sm), q0, name)
+    q1 = kin.ik(path(s1), qm, name)
+    if np.max(np.abs(qm - q0)) <= MAX_JOINT_JUMP and np.max(np.abs(q1 - qm)) <= MAX_JOINT_JUMP:
+        return q1
+    if depth >= 4:
+        k = int(np.argmax(np.maximum(np.abs(qm - q0), np.abs(q1 - qm))))
+        p = path(sm).position * 1000
+        raise MotionError(name, f"the path passes a singularity near ({p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f}) mm: "
+                                f"{kin.joint_names[k]} would have to turn abruptly")
+    qm = _bridge(kin, path, s0, sm, q0, name, depth + 1)
+    return _bridge(kin, path, sm, s1, qm, name, depth + 1)
+
+
+# -- constructors ------------------------------------------------------------------------------------
+def movej(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose | None = None,
+          q_target: Iterable[float] | None = None, speed: Speed = Speed(), name: str = "MoveJ") -> Trajectory:
+    """Joint-interpolated move to a TCP pose (solved by IK near q_start) or to joint positions.
+
+    All axes start and stop together. The cruise time is the longest of each axis's |dq| / max speed,
+    the TCP's path length / v_tcp and the tool's rotation / v_ori.
+    """
+    speed.check(name)
+    q0 = _as_q(q_start, kin.n, name, "the start")
+    if (target_pose is None) == (q_target is None):
+        raise MotionError(name, "MoveJ needs either a target pose or target joint positions")
+    if target_pose is not None:
+        q1 = kin.ik(target_pose, q0, name)
+    else:
+        q1 = _as_q(q_target, kin.n, name, "the target")
+        _check_limits(q1, kin.limits, name)
+    # TCP path length and rotation, sampled along the joint-space line
+    steps = max(2, min(64, math.ceil(float(np.max(np.abs(q1 - q0))) / math.radians(2.0))))
+    poses = [kin.fk(q0 + (q1 - q0) * (i / steps)) for i in range(steps + 1)]
+    length = sum(a.distance(b) for a, b in zip(poses, poses[1:]))
+    angle = sum(a.angle(b) for a, b in zip(poses, poses[1:]))
+    knots = np.array([q0, q1])
+    cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots, kin.limits, speed))
+    return Trajectory("MoveJ", name, knots, Profile(cruise, speed.ramp), None, length)
+
+
+def moveabsj(q_start: Iterable[float], q_target: Iterable[float], speed: Speed = Speed(),
+             joint_limits: Sequence[JointLimit] = (), name: str = "MoveAbsJ",
+             kin: ArmKinematics | None = None) -> Trajectory:
+    """Joint move to absolute joint positions (rad). Without `kin` only the axes' speed limits time it;
+    with it, the TCP speed and reorientation speed count too (as in `movej`)."""
+    speed.check(name)
+    if kin is not None:
+        traj = movej(kin, q_start, None, q_target, speed, name)
+        traj.kind = "MoveAbsJ"
+        return traj
+    n = len(joint_limits)
+    q0 = _as_q(q_start, n, name, "the start")
+    q1 = _as_q(q_target, n, name, "the target")
+    _check_limits(q1, joint_limits, name)
+    knots = np.array([q0, q1])
+    return Trajectory("MoveAbsJ", name, knots, Profile(_joint_cruise(knots, joint_limits, speed), speed.ramp))
+
+
+def movel(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose, speed: Speed = Speed(),
+          name: str = "MoveL") -> Trajectory:
+    """The TCP on a straight line to target_pose, orientation slerped, at v_tcp and v_ori."""
+    speed.check(name)
+    q0 = _as_q(q_start, kin.n, name, "the start")
+    start = kin.fk(q0)
+    end = Pose(target_pose.position, target_pose.orientation)
+    kin.ik(end, q0, name)  # an unreachable end point is reported as such, before any sampling
+    return _cartesian("MoveL", kin, q0, lambda s: start.interpolate(end, s), start.distance(end), start.angle(end),
+                      speed, name)
+
+
+def circle_through(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, name: str) -> tuple[np.ndarray, float, np.ndarray, np.ndarray, float, float]:
+    """Centre, radius, in-plane unit vectors u (towards p0) and w, and the angles of p1 and p2 (rad)."""
+    a, b = p1 - p0, p2 - p0
+    n = np.cross(a, b)
+    nn = float(n @ n)
+    la, lb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+    if la < 1e-6 or lb < 1e-6 or float(np.linalg.norm(p2 - p1)) < 1e-6 or math.sqrt(nn) < 1e-6 * la * lb:
+        raise MotionError(name, "no circle: the start, via point and end point are on one line or coincide")
+    centre = p0 + np.cross((a @ a) * b - (b @ b) * a, n) / (2.0 * nn)
+    radius = float(np.linalg.norm(p0 - centre))
+    u = (p0 - centre) / radius
+    w = np.cross(n / math.sqrt(nn), u)
+
+    def ang(p: np.ndarray) -> float:
+        d = p - centre
+        return math.atan2(float(d @ w), float(d @ u)) % (2 * math.pi)
+
+    return centre, radius, u, w, ang(p1), ang(p2)
+
+
+def movec(kin: ArmKinematics, q_start: Iterable[float], via_pose: Pose, target_pose: Pose, speed: Speed = Speed(),
+          name: str = "MoveC") -> Trajectory:
+    """The TCP on the circular arc from where it is, through via_pose's position, to target_pose.
+
+    The orientation is slerped from the start to the target's (the via point's orientation is not used).
+    """
+    speed.check(name)
+    q0 = _as_q(q_start, kin.n, name, "the start")
+    start = kin.fk(q0)
+    end = Pose(target_pose.position, target_pose.orientation)
+    centre, radius, u, w, _, phi = circle_through(start.position, via_pose.position, end.position, name)
+    kin.ik(end, q0, name)
+
+    def path(s: float) -> Pose:
+        a = s * phi
+        return Pose(centre + radius * (math.cos(a) * u + math.sin(a) * w), slerp(start.orientation, end.orientation, s))
+
+    return _cartesian("MoveC", kin, q0, path, radius * phi, start.angle(end), speed, name)

@@ -1,0 +1,133 @@
+"""The robot in the physics world: drives an arm's joints along a trajectory, step by step.
+
+`Robot.update(t)` is called once per simulation step, before the physics steps from t to t + dt. It
+commands pybullet's POSITION_CONTROL towards where the trajectory will be at the end of the step
+(`q(t + dt)`, with `qd(t + dt)` as the velocity feed-forward), with the axes' URDF efforts as force
+limits. After the planned duration the robot keeps commanding the end point and stays busy until the
+TCP has settled there (within `settle_distance` and `settle_angle`), or `settle_timeout` has passed.
+When idle it holds its last commanded position. The arm's joints are looked up by name, so the body may
+carry more joints (a gripper merged under the flange).
+"""
+from __future__ import annotations
+
+import math
+from typing import Iterable, Sequence
+
+import numpy as np
+import pybullet
+
+from .errors import MotionError
+from .geometry import Pose
+from .kinematics import ARM_JOINTS, ArmKinematics
+from .motion import Trajectory
+
+
+class Robot:
+    """An arm living in a physics world, driven along trajectories in simulated time."""
+
+    def __init__(self, client, body_id: int, joint_names: Sequence[str] = ARM_JOINTS,
+                 kinematics: ArmKinematics | None = None, *, dt: float | None = None,
+                 position_gain: float = 0.3, velocity_gain: float = 1.0,
+                 settle_distance: float = 2e-4, settle_angle: float = math.radians(0.02),
+                 settle_timeout: float = 2.0):
+        self.client = client
+        self.body = body_id
+        self.kinematics = kinematics
+        index: dict[str, int] = {}
+        for j in range(client.getNumJoints(body_id)):
+            index[client.getJointInfo(body_id, j)[1].decode()] = j
+        missing = [n for n in joint_names if n not in index]
+        if missing:
+            raise MotionError(missing[0], f"the robot body has no joint {missing[0]!r}")
+        self.joint_names = tuple(joint_names)
+        self.joints = [index[n] for n in joint_names]
+        self.forces = [float(client.getJointInfo(body_id, j)[10]) for j in self.joints]
+        if dt is None:
+            dt = float(client.getPhysicsEngineParameters()["fixedTimeStep"])
+        self.dt = dt
+        self.position_gain, self.velocity_gain = position_gain, velocity_gain
+        self.settle_distance, self.settle_angle, self.settle_timeout = settle_distance, settle_angle, settle_timeout
+        self._traj: Trajectory | None = None
+        self._t0 = 0.0
+        self._settled = True
+        self._hold = self.q
+
+    # -- state --------------------------------------------------------------------------------------
+    @property
+    def q(self) -> np.ndarray:
+        """Actual joint positions (rad)."""
+        return np.array([s[0] for s in self.client.getJointStates(self.body, self.joints)])
+
+    @property
+    def qd(self) -> np.ndarray:
+        """Actual joint velocities (rad/s)."""
+        return np.array([s[1] for s in self.client.getJointStates(self.body, self.joints)])
+
+    @property
+    def trajectory(self) -> Trajectory | None:
+        return self._traj
+
+    def tcp_pose(self) -> Pose:
+        """The TCP of the actual joint positions, in the world (through the kinematics' own connection)."""
+        if self.kinematics is None:
+            raise MotionError("tcp", "the robot has no kinematics")
+        return self.kinematics.fk(self.q)
+
+    # -- commands -----------------------------------------------------------------------------------
+    def reset(self, q: Iterable[float]) -> None:
+        """Teleport the arm to q (rad) at rest and hold it there (at load time, not during a motion)."""
+        q = np.array([float(v) for v in q])
+        if q.shape != (len(self.joints),):
+            raise ValueError(f"expected {len(self.joints)} joint values")
+        for j, v in zip(self.joints, q):
+            self.client.resetJointState(self.body, j, float(v), 0.0)
+        self._traj, self._settled, self._hold = None, True, q
+        self._command(q, np.zeros_like(q))
+
+    def start(self, trajectory: Trajectory, t: float) -> None:
+        """Run `trajectory` from simulated time t (s). It replaces any motion under way."""
+        self._traj, self._t0, self._settled = trajectory, float(t), False
+
+    def stop(self) -> None:
+        """Stop following the trajectory and hold where the arm is now."""
+        self._traj, self._settled, self._hold = None, True, self.q
+
+    def busy(self, t: float) -> bool:
+        """True while a motion runs or has not yet settled at its end point."""
+        if self._traj is None or self._settled:
+            return False
+        tau = t - self._t0
+        if tau < self._traj.duration:
+            return True
+        if tau >= self._traj.duration + self.settle_timeout:
+            return False
+        return not self._in_position()
+
+    def _in_position(self) -> bool:
+        if self.kinematics is None:
+            return bool(np.max(np.abs(self.q - self._traj.q_end)) < 1e-4)
+        actual, planned = self.kinematics.fk(self.q), self.kinematics.fk(self._traj.q_end)
+        return actual.distance(planned) <= self.settle_distance and actual.angle(planned) <= self.settle_angle
+
+    def update(self, t: float) -> None:
+        """Command the arm for the step from t to t + dt (call once per step, before physics steps)."""
+        traj = self._traj
+        if traj is None:
+            self._command(self._hold, np.zeros(len(self.joints)))
+            return
+        tau = t - self._t0 + self.dt
+        if not self._settled and tau - self.dt >= traj.duration and not self.busy(t):
+            self._settled = True
+        if tau >= traj.duration:
+            self._hold = traj.q_end
+            self._command(self._hold, np.zeros(len(self.joints)))
+        else:
+            self._command(traj.q(tau), traj.qd(tau))
+
+    def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
+        n = len(self.joints)
+        self.client.setJointMotorControlArray(self.body, self.joints, pybullet.POSITION_CONTROL,
+                                              targetPositions=[float(v) for v in q],
+                                              targetVelocities=[float(v) for v in qd],
+                                              forces=self.forces, positionGains=[self.position_gain] * n,
+                                              velocityGains=[self.velocity_gain] * n)
