@@ -48,6 +48,7 @@ class Robot:
         self.position_gain, self.velocity_gain = position_gain, velocity_gain
         self.settle_distance, self.settle_angle, self.settle_timeout = settle_distance, settle_angle, settle_timeout
         self._traj: Trajectory | None = None
+        self._fault: str | None = None
         self._t0 = 0.0
         self._settled = True
         self._hold = self.q
@@ -81,16 +82,46 @@ class Robot:
             raise ValueError(f"expected {len(self.joints)} joint values")
         for j, v in zip(self.joints, q):
             self.client.resetJointState(self.body, j, float(v), 0.0)
-        self._traj, self._settled, self._hold = None, True, q
+        self._traj, self._settled, self._hold, self.fault = None, True, q, None
         self._command(q, np.zeros_like(q))
+        self.check_kinematics()
+
+    def check_kinematics(self, tolerance: float = 1e-4) -> None:
+        """MotionError unless the kinematics' last arm link is where the physics body's is, for the actual q.
+
+        Catches a kinematics placed at the wrong base frame (pybullet's getBasePositionAndOrientation gives
+        the base's centre of mass, which is the URDF base frame only when the base's inertial origin is 0).
+        """
+        if self.kinematics is None:
+            return
+        kin = self.kinematics
+        s = self.client.getLinkState(self.body, self.joints[-1], computeForwardKinematics=True)
+        physics = Pose(s[4], s[5])
+        kin._set(self.q)
+        k = kin.client.getLinkState(kin.body, kin.joints[-1], computeForwardKinematics=True)
+        planned = Pose(k[4], k[5])
+        if physics.distance(planned) > tolerance or physics.angle(planned) > tolerance:
+            d = (physics.position - planned.position) * 1000
+            raise MotionError("robot", f"the kinematics do not match the physics body: {self.joint_names[-1]}'s link is "
+                                       f"off by ({d[0]:.1f}, {d[1]:.1f}, {d[2]:.1f}) mm and "
+                                       f"{math.degrees(physics.angle(planned)):.2f} deg (wrong base frame?)")
 
     def start(self, trajectory: Trajectory, t: float) -> None:
         """Run `trajectory` from simulated time t (s). It replaces any motion under way."""
-        self._traj, self._t0, self._settled = trajectory, float(t), False
+        self._traj, self._t0, self._settled, self.fault = trajectory, float(t), False, None
 
     def stop(self) -> None:
         """Stop following the trajectory and hold where the arm is now."""
         self._traj, self._settled, self._hold = None, True, self.q
+
+    @property
+    def fault(self) -> str | None:
+        """Why the last motion ended without arriving (e.g. blocked by a collision), else None."""
+        return self._fault
+
+    @fault.setter
+    def fault(self, value: str | None) -> None:
+        self._fault = value
 
     def busy(self, t: float) -> bool:
         """True while a motion runs or has not yet settled at its end point."""
@@ -118,6 +149,10 @@ class Robot:
         tau = t - self._t0 + self.dt
         if not self._settled and tau - self.dt >= traj.duration and not self.busy(t):
             self._settled = True
+            if not self._in_position():
+                off = self.tcp_pose().distance(self.kinematics.fk(traj.q_end)) * 1000 if self.kinematics else float("nan")
+                self.fault = (f"target {traj.name!r}: not reached {self.settle_timeout:g} s after the motion's end "
+                              f"(TCP {off:.1f} mm away; blocked?)")
         if tau >= traj.duration:
             self._hold = traj.q_end
             self._command(self._hold, np.zeros(len(self.joints)))
