@@ -222,3 +222,37 @@ def test_a_wrong_station_or_a_busy_port_is_one_line_on_stderr_and_exit_2(lockste
     r = subprocess.run([sys.executable, "-m", "twin", "serve", str(RING_BENCH), "--port", str(lockstep_server.port)],
                        capture_output=True, text=True, cwd=ROOT, timeout=60)
     assert r.returncode == 2 and "cannot listen on" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_the_smart_gripper_grips_its_cube_in_real_time_by_one_register_write():
+    from modbus_helpers import SMART_GRIPPER
+
+    from twin.modbus.register_map import build_map
+
+    rmap = build_map(SMART_GRIPPER)
+    with ServerProcess(SMART_GRIPPER) as server, connect(server) as c:
+        ok(c.write_register(rmap["jaw_left"].address, 0, device_id=UNIT))  # close: 0.00 mm
+        deadline = time.monotonic() + 10
+        while not ok(c.read_discrete_inputs(rmap["doGripped"].address, count=1, device_id=UNIT)).bits[0]:
+            assert time.monotonic() < deadline, "the cube was not gripped within 10 s"
+            time.sleep(0.02)
+        assert ok(c.read_input_registers(rmap["GrippedPart"].address, count=1, device_id=UNIT)).registers == [1]
+        jaw = ok(c.read_input_registers(rmap["jaw_left.actual"].address, count=1, device_id=UNIT)).registers[0]
+        assert 800 < jaw < 1000  # ~9.3 mm: the 20 mm cube between two jaws
+        assert ok(c.read_coils(rmap["Active"].address, count=1, device_id=UNIT)).bits[0]
+
+
+def test_the_ring_rig_serves_its_robot_axes_in_hundredths_of_a_degree():
+    from twin.modbus.register_map import build_map
+
+    ring_rig = ROOT / "stations" / "ring_rig"
+    rmap = build_map(ring_rig)
+    with ServerProcess(ring_rig, "--lockstep") as server, connect(server) as c:
+        advance(c, 10, [{"name": "sim.advance", "address": rmap["sim.advance"].address}])
+        e = rmap["robot.j1"]
+        words = ok(c.read_input_registers(e.address, count=12, device_id=UNIT)).registers
+        axes = [rmap[f"robot.j{i}"].decode(words[2 * i - 2:2 * i]) for i in range(1, 7)]
+        assert axes == pytest.approx([0.0, 0.0, 0.0, 0.0, 90.0, 0.0], abs=0.02)  # home_deg
+        assert not ok(c.read_discrete_inputs(rmap["robot.busy"].address, count=1, device_id=UNIT)).bits[0]
+        assert rmap["L2.actual"].decode(ok(c.read_input_registers(rmap["L2.actual"].address, count=1,
+                                                                  device_id=UNIT)).registers) == pytest.approx(350, abs=1)
