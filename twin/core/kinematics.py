@@ -87,8 +87,11 @@ class ArmKinematics:
         if movable != self.joints:
             raise MotionError(flange_link, f"{self.urdf_path.name}: the movable joints must be exactly {self.joint_names} in order")
         self.flange = links[flange_link]
-        self.limits = tuple(JointLimit(n, *(float(v) for v in c.getJointInfo(self.body, j)[8:12]))
-                            for n, j in zip(self.joint_names, self.joints))
+        limits = []
+        for n, j in zip(self.joint_names, self.joints):
+            info = c.getJointInfo(self.body, j)  # [8] lower, [9] upper, [10] max force, [11] max velocity
+            limits.append(JointLimit(n, float(info[8]), float(info[9]), float(info[11]), float(info[10])))
+        self.limits = tuple(limits)
         self.lower = np.array([lim.lower for lim in self.limits])
         self.upper = np.array([lim.upper for lim in self.limits])
         self.max_velocity = np.array([lim.velocity for lim in self.limits])

@@ -29,6 +29,8 @@ SAMPLE_STEP = 0.005
 SAMPLE_ANGLE = math.radians(0.5)
 #: Between two neighbouring samples no axis may jump more than this (a configuration flip).
 MAX_JOINT_JUMP = math.radians(5.0)
+#: MoveC: the three points must be this far apart and not within 0.06 degrees of one line.
+MIN_CIRCLE_POINT_DISTANCE = 0.001
 
 
 @dataclass(frozen=True)
@@ -260,8 +262,9 @@ def circle_through(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, name: str) ->
     n = np.cross(a, b)
     nn = float(n @ n)
     la, lb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
-    if la < 1e-6 or lb < 1e-6 or float(np.linalg.norm(p2 - p1)) < 1e-6 or math.sqrt(nn) < 1e-6 * la * lb:
-        raise MotionError(name, "no circle: the start, via point and end point are on one line or coincide")
+    if min(la, lb, float(np.linalg.norm(p2 - p1))) < MIN_CIRCLE_POINT_DISTANCE or math.sqrt(nn) < 1e-3 * la * lb:
+        raise MotionError(name, "no circle: the start, via point and end point are on one line or less than "
+                                f"{MIN_CIRCLE_POINT_DISTANCE * 1000:g} mm apart")
     centre = p0 + np.cross((a @ a) * b - (b @ b) * a, n) / (2.0 * nn)
     radius = float(np.linalg.norm(p0 - centre))
     u = (p0 - centre) / radius
