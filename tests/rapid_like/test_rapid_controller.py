@@ -1,0 +1,205 @@
+"""The controller as a station binding drives it: tick(now) once per step, a host whose motions
+take time, stop/start/resume, and loops that consume no time."""
+from __future__ import annotations
+
+import pytest
+
+from rapid_like import CheckError, Controller, Host, InMemoryHost, MotionRequest, SignalInfo, parse
+
+DT = 0.012
+
+
+def make(src: str, signals=(), entry="main", host=None, step=None):
+    events: list[dict] = []
+    host = host or InMemoryHost([SignalInfo(n, k) for k, n in signals])
+    ctl = Controller(parse(src, "t.mod"), host, entry, on_event=events.append, step=step)
+    return ctl, host, events
+
+
+def prints(events):
+    return [(e["t"], e["text"]) for e in events if e["type"] == "print"]
+
+
+class SlowHost(InMemoryHost):
+    """A host whose motions take `ticks` calls of motion_done, like a robot moving in the world."""
+
+    def __init__(self, signals, ticks: int):
+        super().__init__(signals)
+        self.ticks = ticks
+        self.remaining: dict[int, int] = {}
+
+    def start_motion(self, request: MotionRequest) -> object:
+        h = super().start_motion(request)
+        self.remaining[h] = self.ticks
+        return h
+
+    def motion_done(self, handle) -> bool:
+        self.remaining[handle] -= 1
+        return self.remaining[handle] < 0
+
+
+def test_in_memory_host_satisfies_the_host_protocol():
+    assert isinstance(InMemoryHost([]), Host)
+
+
+def test_a_time_less_loop_yields_once_per_tick():
+    ctl, host, _ = make("""
+        MODULE M
+          VAR num n := 0;
+          PROC main()
+            WHILE TRUE DO
+              Incr n;
+            ENDWHILE
+          ENDPROC
+        ENDMODULE""")
+    for k in range(50):
+        ctl.tick(k * DT)  # returns: the loop does not hang the caller
+    assert ctl.state == "waiting"
+    assert ctl.interp.globals["n"].value == 50  # one iteration per tick
+
+
+def test_wait_time_resumes_at_the_first_tick_after_its_end():
+    ctl, _, events = make("""
+        MODULE M
+          PROC main()
+            WaitTime 0.2;
+            TPWrite "done";
+          ENDPROC
+        ENDMODULE""")
+    k = 0
+    while ctl.state != "completed":
+        ctl.tick(k * DT)
+        k += 1
+    # 0.2 s is not a multiple of 12 ms: the first tick at or after it is 17 * 0.012 = 0.204
+    assert prints(events) == [(0.204, "done")]
+
+
+def test_motion_waits_until_the_host_reports_it_done():
+    host = SlowHost([SignalInfo("doAtPick", "DO")], ticks=5)
+    ctl, host, events = make("""
+        MODULE M
+          PERS tooldata tGrip := [TRUE,[[0,0,350],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
+          PERS wobjdata wPallet := [FALSE,TRUE,"",[[1600,-800,150],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];
+          CONST robtarget pPick := [[0,0,30],[0,1,0,0],[-1,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+          PROC main()
+            MoveL pPick, v1000, fine, tGrip \\WObj:=wPallet;
+            Set doAtPick;
+          ENDPROC
+        ENDMODULE""", host=host)
+    ctl.tick(0.0)
+    assert ctl.state == "waiting"
+    req = host.moves[0]
+    assert (req.instr, req.target_name, req.speed_name, req.zone_name, req.tool_name, req.wobj_name) == \
+        ("MoveL", "pPick", "v1000", "fine", "tGrip", "wPallet")
+    assert req.target.fields["trans"].fields["z"] == 30
+    assert req.wobj.fields["uframe"].fields["trans"].fields["x"] == 1600
+    assert req.tool.fields["tframe"].fields["trans"].fields["z"] == 350
+    ticks = 1
+    while host.values["doAtPick"] == 0:
+        ctl.tick(ticks * DT)
+        ticks += 1
+        assert ticks < 20
+    assert ticks == 6  # motion_done was False five times, True on the sixth poll
+    assert [e["type"] for e in events] == ["move", "DO", "end"]
+
+
+def test_stop_then_start_restarts_from_the_entry_routine():
+    ctl, _, events = make("""
+        MODULE M
+          PERS num runs := 0;
+          VAR num stepsDone := 0;
+          PROC main()
+            Incr runs;
+            TPWrite "run " \\Num:=runs;
+            WaitTime 1;
+            Incr stepsDone;
+            TPWrite "steps " \\Num:=stepsDone;
+          ENDPROC
+        ENDMODULE""")
+    ctl.tick(0.0)
+    ctl.tick(0.5)
+    ctl.stop()
+    ctl.tick(1.2)  # stopped: the WaitTime does not finish
+    assert ctl.state == "stopped"
+    ctl.start()
+    ctl.tick(2.0)
+    ctl.tick(3.0)
+    assert ctl.state == "completed"
+    assert prints(events) == [(0.0, "run 1"), (2.0, "run 2"), (3.0, "steps 1")]
+    ends = [e["reason"] for e in events if e["type"] == "end"]
+    assert ends == ["stop", "completed"]
+
+
+def test_resume_continues_after_a_stop_instruction():
+    ctl, _, events = make("""
+        MODULE M
+          PROC main()
+            TPWrite "a";
+            Stop;
+            TPWrite "b";
+          ENDPROC
+        ENDMODULE""")
+    ctl.tick(0.0)
+    assert ctl.state == "stopped" and ctl.end_reason == "stop"
+    ctl.resume()
+    ctl.tick(0.1)
+    assert ctl.state == "completed"
+    assert [t for _, t in prints(events)] == ["a", "b"]
+
+
+def test_signals_are_read_live_each_time_they_are_evaluated():
+    ctl, host, events = make("""
+        MODULE M
+          PROC main()
+            WaitUntil diGripped = 1;
+            TPWrite "gripped";
+          ENDPROC
+        ENDMODULE""", signals=[("DI", "diGripped")])
+    for k in range(10):
+        ctl.tick(k * 0.05)
+    assert prints(events) == []
+    host.set_input("diGripped", 1)
+    ctl.tick(0.5)
+    assert prints(events) == [(0.5, "gripped")]
+
+
+def test_runtime_error_sets_error_state_with_position():
+    ctl, _, events = make("""MODULE M
+  PROC main()
+    VAR num z;
+    z := 4 / z;
+  ENDPROC
+ENDMODULE""")
+    ctl.tick(0.0)
+    assert ctl.state == "error"
+    assert (ctl.error.span.line, ctl.error.span.col) == (4, 12)
+    assert events[-1]["type"] == "error" and events[-1]["line"] == 4
+
+
+def test_static_errors_are_raised_before_anything_runs():
+    with pytest.raises(CheckError) as e:
+        make("""MODULE M
+  PROC main()
+    SetDO doMissing, 1;
+  ENDPROC
+ENDMODULE""")
+    assert (e.value.span.line, e.value.span.col) == (3, 11)
+
+
+def test_missing_entry_routine_is_a_check_error():
+    with pytest.raises(CheckError, match="no routine named 'Init'"):
+        make("MODULE M\n PROC main()\n ENDPROC\nENDMODULE", entry="Init")
+
+
+def test_next_wake_reports_the_end_of_a_wait_and_pending_pulses():
+    ctl, _, _ = make("""
+        MODULE M
+          PROC main()
+            PulseDO \\PLength:=0.3, doP;
+            WaitTime 0.5;
+          ENDPROC
+        ENDMODULE""", signals=[("DO", "doP")])
+    ctl.tick(0.0)
+    assert ctl.next_wake_ns() == 300_000_000
+    ctl.tick(0.3)
+    assert ctl.next_wake_ns() == 500_000_000
