@@ -18,7 +18,7 @@ restarts it from the entry routine (VAR data re-initialised, PERS kept).
 Events (`on_event(dict)`), each with `t` in seconds rounded to 1 us: output writes
 `{"type": "DO"|"AO"|"GO", "signal", "value"}`, `{"type": "print", "text"}`, motions
 `{"type": "move", "instr", "to", ["via"], "speed", "zone", "tool", "wobj"}`, and last
-`{"type": "end", "reason"}` or `{"type": "error", "line", "col", "message"}`.
+`{"type": "end", "reason"}` or `{"type": "error", "line", "message"}` (the column is in `error`).
 
 A binding to a physics station implements `host.Host` (signals wired to the gripper, motions
 driving the robot, `motion_done` true when the robot is in position) and calls `tick(now)` once
@@ -85,7 +85,6 @@ class Controller:
         self.state, self.end_reason, self.error, self.wait = RUNNING, None, None, None
         self._ended_reported = False
         self._gen = None
-        self._init_pending = True
 
     def stop(self) -> None:
         """Halt the program where it is (resume() continues, start() restarts)."""
@@ -181,5 +180,4 @@ class Controller:
         self.state, self.error, self.wait = ERROR, err, None
         self.interp.pulses.clear()
         span = err.span
-        self._emit({"type": "error", "line": span.line if span else 0, "col": span.col if span else 0,
-                    "message": err.message})
+        self._emit({"type": "error", "line": span.line if span else 0, "message": err.message})

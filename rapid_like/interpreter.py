@@ -155,7 +155,7 @@ class Interpreter:
         self.now = 0  # ns, set by the controller before every resume
         self.suspensions = 0  # bumped by the controller each time the program stays suspended over a tick
         self.errno = 0.0
-        self.pulses: list[tuple[int, str, float]] = []  # (due ns, signal, value to write)
+        self.pulses: list[tuple[int, str, float]] = []  # scheduled writes: (due ns, signal, value)
         self.next_user_errno = B.USER_ERRNO_BASE
 
     # ---- set-up ---------------------------------------------------------------------------------
@@ -690,7 +690,13 @@ class Interpreter:
         yield from ()
 
     def i_setdo(self, s, arg, text, bound):
-        self.write(arg("signal"), arg("value"), bound["value"].value.span)
+        sig, value, delay = arg("signal"), arg("value"), arg("sdelay")
+        if delay:  # \SDelay: the program goes on, the output changes `delay` seconds later
+            if value not in (0, 1):
+                raise self.fail(f"a digital output is 0 or 1, not {fmt_num(value)}", bound["value"].value.span)
+            self.pulses.append((self.now + to_ns(delay), sig.name, float(value)))
+        else:
+            self.write(sig, value, bound["value"].value.span)
         yield from ()
 
     def i_setao(self, s, arg, text, bound):
@@ -780,7 +786,7 @@ class Interpreter:
                 if flag is not None:
                     flag.set(True)
                     return
-                raise self.fail(f"{name}: the time limit of {fmt_num(maxtime)} s ran out", s.span,
+                raise self.fail(f"{name} timed out: \\MaxTime of {fmt_num(maxtime)} s ran out", s.span,
                                 "ERR_WAIT_MAXTIME")
             if poll:
                 k += 1

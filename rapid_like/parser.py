@@ -34,6 +34,10 @@ class Parser:
         self.pos = 0
         self.source = source
         self.file = file
+        self.line_starts = [0]
+        for i, ch in enumerate(source):
+            if ch == "\n":
+                self.line_starts.append(i + 1)
 
     # ---- helpers -------------------------------------------------------------------------------
     @property
@@ -513,15 +517,10 @@ class Parser:
         return n.Name(t.span, t.text, t.text)
 
     def postfix(self, expr: n.Expr) -> n.Expr:
-        start_off = None
+        """`expr.field.field ...`"""
+        start = self.line_starts[expr.span.line - 1] + expr.span.col - 1
         while self.tok.is_op("."):
             self.advance()
             f = self.expect_ident("a component name after '.'")
-            text = self.source[self._offset_of(expr):f.end]
-            expr = n.Component(expr.span, text, expr, f.text, f.span)
-        del start_off
+            expr = n.Component(expr.span, self.source[start:f.end], expr, f.text, f.span)
         return expr
-
-    def _offset_of(self, expr: n.Expr) -> int:
-        lines = self.source.splitlines(keepends=True)
-        return sum(len(x) for x in lines[: expr.span.line - 1]) + expr.span.col - 1

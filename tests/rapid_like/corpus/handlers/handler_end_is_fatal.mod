@@ -1,7 +1,7 @@
 ! An ERROR handler that ends without RETRY, TRYNEXT, RETURN or RAISE leaves the error to the
 ! system error handler: the program stops with the original error.
 ! trace: {"t": 0.0, "type": "print", "text": "handler ran"}
-! trace: {"t": 0.0, "type": "error", "line": 10, "col": 12, "message": "division by zero (ERR_DIVZERO)"}
+! trace: {"t": 0.0, "type": "error", "line": 10, "message": "division by zero (ERR_DIVZERO)"}
 ! error: 10:12 division by zero
 ! exit: 70
 MODULE Unhandled

@@ -2,7 +2,7 @@
 ! reported at the instruction.
 ! args: --io DI:diGripped
 ! trace: {"t": 0.0, "type": "print", "text": "waiting"}
-! trace: {"t": 1.5, "type": "error", "line": 11, "col": 5, "message": "WaitUntil: the time limit of 1.5 s ran out (ERR_WAIT_MAXTIME)"}
+! trace: {"t": 1.5, "type": "error", "line": 11, "message": "WaitUntil timed out: \\MaxTime of 1.5 s ran out (ERR_WAIT_MAXTIME)"}
 ! error: 11:5 ERR_WAIT_MAXTIME
 ! exit: 70
 MODULE Timeout
