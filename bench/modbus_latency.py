@@ -5,8 +5,8 @@
 Both servers run in their own process on loopback; the client side is one process with minimal raw
 sockets (so the figures are the servers', not a client library's). Measured in one run, side by side:
 
-- round-trip latency of one register read (FC 4, the station's input registers from GrippedPart on:
-  the same count of registers on both), one request at a time on one connection: p50 and p99;
+- round-trip latency of one register read (FC 4, all the station's input registers from GrippedPart
+  on: 23 on the ring rig; the same addresses on both), one request at a time on one connection: p50 and p99;
 - throughput: requests per second with 1 client, then with C clients (default 10) each polling
   request-after-response over its own connection;
 - for `twin serve`: how many simulation steps were late (finished after their wall-clock deadline)
@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-DEFAULT_STATION = ROOT / "tests" / "plc" / "stations" / "ring_bench"  # the ring rig's gripper, no robot
+DEFAULT_STATION = ROOT / "stations" / "ring_rig"  # the thesis rig: arm, 3-finger gripper, ring
 
 
 # -- the servers --------------------------------------------------------------------------------------------
