@@ -87,10 +87,10 @@ def build_parser() -> argparse.ArgumentParser:
     chk = sub.add_parser("check", help="parse and check a program without running it")
     for sp in (run, chk):
         sp.add_argument("program", help="a RAPID module (.mod)")
-        sp.add_argument("--io", action="append", default=[], metavar="TYPE:NAME,...",
+        sp.add_argument("--io", action="extend", nargs="+", default=[], metavar="TYPE:NAME,...",
                         help="configure I/O signals, e.g. DI:diGripped,AO:aoAxis1 (repeatable)")
         sp.add_argument("--entry", default="main", help="routine to start from (default: main)")
-    run.add_argument("--set", action="append", default=[], metavar="NAME=VALUE[@T]",
+    run.add_argument("--set", action="extend", nargs="+", default=[], metavar="NAME=VALUE[@T]",
                      help="set a signal at simulated time T seconds (default 0); repeatable")
     run.add_argument("--max-time", type=float, default=DEFAULT_MAX_TIME, metavar="T",
                      help="end the run at simulated time T, reason time_limit (default "
@@ -101,8 +101,20 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _program_first(argv: list[str]) -> list[str]:
+    """Put the program right after the sub-command, so `--io A B` lists never swallow it."""
+    if len(argv) < 2 or argv[0] not in ("run", "check"):
+        return argv
+    rest = argv[1:]
+    for i, a in enumerate(rest):
+        if not a.startswith("-") and a.lower().endswith((".mod", ".modx", ".prg", ".sys")):
+            return [argv[0], a, *rest[:i], *rest[i + 1:]]
+    return argv
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser().parse_args(_program_first(argv))
     out, err = sys.stdout, sys.stderr
     path = Path(args.program)
     try:

@@ -174,6 +174,8 @@ class Controller:
             self._fail(e.error)
         except ExecError as e:
             self._fail(e)
+        except RecursionError:
+            self._fail(ExecError("routine calls nested too deeply (endless recursion?)", None, 0))
         self._gen = None if self.state == ERROR else self._gen
 
     def _fail(self, err: ExecError) -> None:

@@ -104,3 +104,8 @@ def test_io_accepts_comma_lists_and_repeats(tmp_path: Path):
     ev = [json.loads(x) for x in out.splitlines()]
     assert ev[0] == {"t": 0.0, "type": "AO", "signal": "aoX", "value": 3}
     assert ev[1] == {"t": 0.0, "type": "GO", "signal": "goZ", "value": 5}
+
+
+def test_io_and_set_take_space_separated_lists_before_or_after_the_program(prog: Path):
+    code, out, err = run_cli(["run", "--io", "DO:doLamp", "DI:diX", str(prog), "--set", "diX=1", "diX=0@1"])
+    assert (code, out, err) == (0, "hello\n", "")
