@@ -175,10 +175,12 @@ def test_movel_through_an_unreachable_stretch_is_refused_before_moving(kin):
     q0 = kin.ik(down(1.6, -0.8, 0.58), HOME, "a")
     with pytest.raises(MotionError, match="'too_far'"):
         movel(kin, q0, down(3.5, -0.8, 0.58), Speed(), "too_far")
-    # both ends reachable, the straight line between them passes through the robot's own base column
-    q_left = kin.ik(Pose.from_xyz_rpy((-0.3, 1.2, 0.6), DOWN), np.radians([100, 0, 0, 0, 90, 0]), "left")
-    with pytest.raises(MotionError, match="'through_base'"):
-        movel(kin, q_left, Pose.from_xyz_rpy((0.3, -1.2, 0.6), DOWN), Speed(), "through_base")
+    # both ends reachable, but the straight line between them passes too close to the robot's base
+    q_right = kin.ik(down(0.6, -1.5, 0.5), np.radians([-80, 0, 0, 0, 90, 0]), "right")
+    kin.ik(down(0.6, 1.5, 0.5), np.radians([80, 0, 0, 0, 90, 0]), "left")
+    with pytest.raises(MotionError, match=r"'past_the_base': at \(600, -?\d+, 500\) mm, \d+% along the path: would need "
+                                          r"joint_\d beyond its limit"):
+        movel(kin, q_right, down(0.6, 1.5, 0.5), Speed(), "past_the_base")
 
 
 def test_moveabsj_beyond_a_joint_limit_is_refused(kin):

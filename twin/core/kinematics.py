@@ -146,10 +146,24 @@ class ArmKinematics:
         wide = np.full(self.n, 4.0 * math.pi)
         q_free, fp, fo = self._solve(goal, seed, -wide, wide, max_iterations)
         if fp <= IK_FAIL_POS and fo <= IK_FAIL_ORI:
-            self.check_limits(q_free, target_name)
+            self.check_limits(self._wrap(q_free), target_name)
         if err_p > IK_FAIL_POS:
             raise MotionError(target_name, f"cannot be reached: closest is {err_p * 1000:.1f} mm away")
         raise MotionError(target_name, f"cannot be reached: closest orientation is {math.degrees(err_o):.2f} deg away")
+
+    def _wrap(self, q: np.ndarray) -> np.ndarray:
+        """Each angle turned by whole turns to lie in its joint's range, or else nearest the range's middle."""
+        out = q.copy()
+        for i, (lim, v) in enumerate(zip(self.limits, q)):
+            mid = (lim.lower + lim.upper) / 2
+            w = v - 2 * math.pi * round((v - mid) / (2 * math.pi))
+            for cand in (v, w, w - 2 * math.pi, w + 2 * math.pi):
+                if lim.contains(cand):
+                    out[i] = cand
+                    break
+            else:
+                out[i] = w
+        return out
 
     def _error(self, goal: Pose) -> tuple[float, float, Pose]:
         f = self._flange()

@@ -171,7 +171,10 @@ def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callabl
     q_prev = q_start
     for i in range(1, n + 1):
         s = i / n
-        q = kin.ik(path(s), q_prev, name)
+        try:
+            q = kin.ik(path(s), q_prev, name)
+        except MotionError as exc:
+            raise _on_path(exc, name, path(s), s) from None
         jump = np.abs(q - q_prev)
         if np.max(jump) > MAX_JOINT_JUMP:
             q = _bridge(kin, path, (i - 1) / n, s, q_prev, name)
@@ -182,12 +185,21 @@ def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callabl
     return Trajectory(kind, name, knots_arr, Profile(cruise, speed.ramp), path, length)
 
 
+def _on_path(exc: MotionError, name: str, pose: Pose, s: float) -> MotionError:
+    reason = str(exc).removeprefix(f"target {name!r}: ")
+    p = pose.position * 1000
+    return MotionError(name, f"at ({p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f}) mm, {s * 100:.0f}% along the path: {reason}")
+
+
 def _bridge(kin: ArmKinematics, path: Callable[[float], Pose], s0: float, s1: float, q0: np.ndarray, name: str,
             depth: int = 0) -> np.ndarray:
     """A jump between two samples: solve the midpoint; raise if the arm really flips configuration."""
     sm = (s0 + s1) / 2
-    qm = kin.ik(path(sm), q0, name)
-    q1 = kin.ik(path(s1), qm, name)
+    try:
+        qm = kin.ik(path(sm), q0, name)
+        q1 = kin.ik(path(s1), qm, name)
+    except MotionError as exc:
+        raise _on_path(exc, name, path(sm), sm) from None
     if np.max(np.abs(qm - q0)) <= MAX_JOINT_JUMP and np.max(np.abs(q1 - qm)) <= MAX_JOINT_JUMP:
         return q1
     if depth >= 4:
