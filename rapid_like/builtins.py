@@ -70,6 +70,10 @@ def predefined_data() -> dict[str, tuple[str, object]]:
     return data
 
 
+# Predefined *variables* (the USER system module's reg1 to reg5).
+PREDEFINED_VARS: dict[str, str] = {f"reg{i}": "num" for i in range(1, 6)}
+
+
 # ---- signatures ----------------------------------------------------------------------------------
 def _sig(text: str) -> list[Param]:
     """Parse a compact signature: `num Value, \\num MaxTime, \\INOUT bool TimeFlag, \\switch High`."""
@@ -115,6 +119,9 @@ INSTRUCTIONS: dict[str, list[Param]] = {k.lower(): _sig(v) for k, v in {
     "VelSet": "num Override, num Max",
     "AccSet": "num Acc, num Ramp",
     "BookErrNo": "INOUT errnum ErrorName",
+    "ClkReset": "INOUT clock Clock",
+    "ClkStart": "INOUT clock Clock",
+    "ClkStop": "INOUT clock Clock",
 }.items()}
 
 FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, (s, r) in {
@@ -139,6 +146,7 @@ FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, 
     "StrLen": ("string Str", "num"),
     "StrPart": ("string Str, num ChPos, num Len", "string"),
     "Dist": ("pos Point1, pos Point2", "num"),
+    "ClkRead": (r"clock Clock, \switch HighRes", "num"),
     "DOutput": ("signaldo Signal", "num"),
     "DInput": ("signaldi Signal", "num"),
     "AOutput": ("signalao Signal", "num"),

@@ -79,6 +79,8 @@ class Checker:
             return self.predefined[key]
         if key == "errno":
             return Sym("data", "errnum", "CONST")
+        if key in B.PREDEFINED_VARS:
+            return Sym("data", B.PREDEFINED_VARS[key], "VAR", name=key)
         if key in self.signals:
             return Sym("signal", "num", "CONST", self.signals[key])
         return None
@@ -442,7 +444,7 @@ _PROPER = {k.lower(): k for k in (
     "Incr Decr Add SetDO SetAO SetGO Set Reset InvertDO PulseDO WaitTime WaitDI WaitDO WaitUntil WaitRob TPWrite "
     "TPErase MoveJ MoveL MoveC MoveAbsJ Stop Break ConfJ ConfL VelSet AccSet BookErrNo Offs RelTool CRobT "
     "CJointT Present Abs Round Trunc Sqrt Pow Exp Sin Cos Tan ATan ATan2 NumToStr ValToStr StrLen StrPart "
-    "Dist DOutput DInput AOutput GOutput TestDI").split()}
+    "Dist DOutput DInput AOutput GOutput TestDI ClkReset ClkStart ClkStop ClkRead").split()}
 
 
 def _proper(key: str) -> str:

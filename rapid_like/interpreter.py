@@ -152,6 +152,7 @@ class Interpreter:
         self.routines = {r.key: r for r in module.routines}
         self.predefined = {k: Cell(t, v, "CONST", k) for k, (t, v) in B.predefined_data().items()}
         self.globals: dict[str, Cell] = {}
+        self.predefined_vars: dict[str, Cell] = {}
         self.now = 0  # ns, set by the controller before every resume
         self.suspensions = 0  # bumped by the controller each time the program stays suspended over a tick
         self.errno = 0.0
@@ -163,6 +164,7 @@ class Interpreter:
         """(Re)initialise module data. PERS data keep their values when `keep_pers`."""
         old = self.globals
         self.globals = {}
+        self.predefined_vars = {k: Cell(t, default_value(t), "VAR", k) for k, t in B.PREDEFINED_VARS.items()}
         top = Frame(n.Routine(self.module.span, "PROC", "<module>", [], []))
         for d in self.module.data:
             if keep_pers and d.storage == "PERS" and d.key in old:
@@ -399,6 +401,8 @@ class Interpreter:
             return self.globals[key]
         if key in self.predefined:
             return self.predefined[key]
+        if key in self.predefined_vars:
+            return self.predefined_vars[key]
         if key in self.signals:
             s = self.signals[key]
             return Cell(SIGNAL_KINDS_T[s.kind], SignalRef(s.name, s.kind), "CONST", s.name)
@@ -627,6 +631,8 @@ class Interpreter:
                 return s[start - 1:start - 1 + length]
             if key == "dist":
                 return B.dist(vals[0], vals[1])
+            if key == "clkread":
+                return x.read(self.now)
         except (ValueError, OverflowError) as exc:
             raise self.fail(f"{e.name}: {exc}", e.span, "ERR_INVALID_VALUE") from None
         raise self.fail(f"function {e.name} is not implemented", e.span)  # pragma: no cover
@@ -687,6 +693,24 @@ class Interpreter:
     def i_bookerrno(self, s, arg, text, bound):
         arg("errorname").set(float(self.next_user_errno))
         self.next_user_errno += 1
+        yield from ()
+
+    def i_clkreset(self, s, arg, text, bound):
+        clock = arg("clock").get()
+        clock.elapsed, clock.started = 0, (self.now if clock.started is not None else None)
+        yield from ()
+
+    def i_clkstart(self, s, arg, text, bound):
+        clock = arg("clock").get()
+        if clock.started is None:
+            clock.started = self.now
+        yield from ()
+
+    def i_clkstop(self, s, arg, text, bound):
+        clock = arg("clock").get()
+        if clock.started is not None:
+            clock.elapsed += self.now - clock.started
+            clock.started = None
         yield from ()
 
     def i_setdo(self, s, arg, text, bound):

@@ -39,7 +39,7 @@ RECORDS: dict[str, list[tuple[str, str]]] = {
     "wobjdata": [("robhold", BOOL), ("ufprog", BOOL), ("ufmec", STRING), ("uframe", "pose"),
                  ("oframe", "pose")],
 }
-KNOWN_TYPES = ATOMIC | set(RECORDS) | set(SIGNAL_TYPES)
+KNOWN_TYPES = ATOMIC | set(RECORDS) | set(SIGNAL_TYPES) | {"clock"}
 
 
 class Record:
@@ -62,6 +62,25 @@ class Record:
 
     def __repr__(self) -> str:
         return format_value(self)
+
+
+class Clock:
+    """A RAPID clock (ClkReset/ClkStart/ClkStop/ClkRead) measuring simulated time, in ns."""
+
+    __slots__ = ("started", "elapsed")
+
+    def __init__(self) -> None:
+        self.started: int | None = None
+        self.elapsed = 0
+
+    def read(self, now: int) -> float:
+        running = now - self.started if self.started is not None else 0
+        return (self.elapsed + running) / 1e9
+
+    def copy(self) -> "Clock":
+        c = Clock()
+        c.started, c.elapsed = self.started, self.elapsed
+        return c
 
 
 class Aggregate(list):
@@ -94,6 +113,8 @@ def default_value(t: str) -> object:
         return ""
     if t in RECORDS:
         return Record(t, {name: default_value(ft) for name, ft in RECORDS[t]})
+    if t == "clock":
+        return Clock()
     raise TypeMismatch(f"no default value for type {t}")
 
 
@@ -108,6 +129,8 @@ def type_of(v: object) -> str:
         return v.type
     if isinstance(v, SignalRef):
         return SIGNAL_KINDS[v.kind]
+    if isinstance(v, Clock):
+        return "clock"
     if isinstance(v, Aggregate):
         return "aggregate"
     return type(v).__name__
@@ -140,6 +163,9 @@ def coerce(v: object, t: str) -> object:
                 except TypeMismatch as e:
                     raise TypeMismatch(f"component {name} of the {t}: {e}") from None
             return Record(t, out)
+    elif t == "clock":
+        if isinstance(v, Clock):
+            return v
     elif t in SIGNAL_TYPES:
         if isinstance(v, SignalRef) and v.kind == SIGNAL_TYPES[t]:
             return v
