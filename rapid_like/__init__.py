@@ -11,6 +11,9 @@ Stages, one per module, dependencies pointing one way:
   simulation step. `host.Host` is the protocol a station binding implements; `host.InMemoryHost`
   is the offline one.
 - `offline.run_offline(...)` and `cli.main(argv)` are the `rapid run` command.
+
+The parser is hand-written recursive descent rather than lark: it reports the first error at its
+true position with messages like "expected ENDIF to close the IF on line 4, found ENDPROC".
 """
 from .controller import Controller, load_program
 from .errors import CheckError, ExecError, LexError, ParseError, RapidError, Span

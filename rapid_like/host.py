@@ -15,6 +15,20 @@ through a `Host`:
 Names passed to read/write are the configured spelling. Values are RAPID nums (digital 0/1, analog
 in the controller's unit, e.g. mm). `InMemoryHost` is the offline host: signals live in a dict and a
 motion is complete as soon as it starts (the robot is at its target at once).
+
+Notes for a station binding (item 5):
+- `signals()` comes from the station file's controller I/O section (name, type, wiring). The
+  controller reads outputs too (`aoAxis1<=440` reads the AO's present value), so `read_signal`
+  must answer for every configured signal, outputs included (the last value written).
+- Wiring is the binding's job: `write_signal("aoAxis1", 331)` in mm becomes the gripper input L2 =
+  0.331 m, the way RobotStudio's expression blocks divide by 1000; a DI such as diGripped reads the
+  twin's grip output. The controller never scales anything.
+- `start_motion` receives targets in mm and quaternions [q1..q4] (q1 = w), in `request.wobj`'s
+  user/object frame, for the TCP of `request.tool` (tframe in the flange frame); `motion_done` is
+  polled on every tick. Zones are not blended: every motion completes (like `fine`) before the
+  next instruction runs.
+- Time: call `Controller.tick(now)` once per control step after applying the step's inputs; the
+  program sees signal values as they are at `now`.
 """
 from __future__ import annotations
 
