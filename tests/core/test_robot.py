@@ -244,3 +244,18 @@ def test_a_kinematics_on_the_wrong_base_frame_is_refused(kin, tmp_path):
             Cell(shifted, tmp_path, HOME)
     finally:
         shifted.close()
+
+
+def test_a_blocked_motion_ends_with_a_fault_naming_the_target(kin, cell):
+    c = cell.client
+    block = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=[0.4, 0.4, 0.15])
+    c.createMultiBody(0, block, basePosition=[1.6, -0.8, 0.2])  # its top at z 0.35, above grip_right
+    traj = movel(kin, cell.robot.q, down(1.6, -0.8, 0.18), Speed(v_tcp=0.5), "grip_right")
+    cell.robot.start(traj)  # from the next update
+    steps = 0
+    while cell.robot.busy(cell.t):
+        cell.step()
+        steps += 1
+    assert steps * DT == pytest.approx(traj.duration + cell.robot.settle_timeout, abs=2 * DT)
+    assert cell.robot.fault is not None and "'grip_right': not reached" in cell.robot.fault
+    assert cell.robot.tcp_pose().position[2] > 0.3

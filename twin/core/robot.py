@@ -48,8 +48,10 @@ class Robot:
         self.position_gain, self.velocity_gain = position_gain, velocity_gain
         self.settle_distance, self.settle_angle, self.settle_timeout = settle_distance, settle_angle, settle_timeout
         self._traj: Trajectory | None = None
-        self._fault: str | None = None
-        self._t0 = 0.0
+        #: why the last motion ended without arriving (e.g. blocked by a collision), else None
+        self.fault: str | None = None
+        self._t0: float | None = 0.0
+        self._end_tcp: Pose | None = None
         self._settled = True
         self._hold = self.q
 
@@ -106,38 +108,47 @@ class Robot:
                                        f"off by ({d[0]:.1f}, {d[1]:.1f}, {d[2]:.1f}) mm and "
                                        f"{math.degrees(physics.angle(planned)):.2f} deg (wrong base frame?)")
 
-    def start(self, trajectory: Trajectory, t: float) -> None:
-        """Run `trajectory` from simulated time t (s). It replaces any motion under way."""
-        self._traj, self._t0, self._settled, self.fault = trajectory, float(t), False, None
+    def start(self, trajectory: Trajectory, t: float | None = None) -> None:
+        """Run `trajectory` from simulated time t (s), or from the next `update` when t is None.
+
+        It replaces any motion under way; build it from `robot.q` when the robot is at rest (a motion
+        started while another runs begins from standstill).
+        """
+        self._traj, self._settled, self.fault = trajectory, False, None
+        self._t0 = None if t is None else float(t)
+        self._end_tcp = self.kinematics.fk(trajectory.q_end) if self.kinematics is not None else None
 
     def stop(self) -> None:
         """Stop following the trajectory and hold where the arm is now."""
         self._traj, self._settled, self._hold = None, True, self.q
 
-    @property
-    def fault(self) -> str | None:
-        """Why the last motion ended without arriving (e.g. blocked by a collision), else None."""
-        return self._fault
-
-    @fault.setter
-    def fault(self, value: str | None) -> None:
-        self._fault = value
-
     def busy(self, t: float) -> bool:
-        """True while a motion runs or has not yet settled at its end point."""
+        """True while a motion runs or has not yet settled at its end point.
+
+        The end of a motion latches: once in position the robot is idle until the next `start`. If it is
+        not in position `settle_timeout` after the planned end, it sets `fault` and holds where it is.
+        """
         if self._traj is None or self._settled:
             return False
+        if self._t0 is None:
+            return True
         tau = t - self._t0
         if tau < self._traj.duration:
             return True
-        if tau >= self._traj.duration + self.settle_timeout:
-            return False
-        return not self._in_position()
+        if self._in_position():
+            self._settled = True
+        elif tau >= self._traj.duration + self.settle_timeout:
+            self._settled = True
+            off = self.tcp_pose().distance(self._end_tcp) * 1000 if self.kinematics is not None else float("nan")
+            self.fault = (f"target {self._traj.name!r}: not reached {self.settle_timeout:g} s after the motion's end "
+                          f"(TCP {off:.1f} mm away; blocked?)")
+            self._traj, self._hold = None, self.q  # stop pushing: hold where it got to
+        return not self._settled
 
     def _in_position(self) -> bool:
         if self.kinematics is None:
             return bool(np.max(np.abs(self.q - self._traj.q_end)) < 1e-4)
-        actual, planned = self.kinematics.fk(self.q), self.kinematics.fk(self._traj.q_end)
+        actual, planned = self.kinematics.fk(self.q), self._end_tcp
         return actual.distance(planned) <= self.settle_distance and actual.angle(planned) <= self.settle_angle
 
     def update(self, t: float) -> None:
@@ -146,13 +157,9 @@ class Robot:
         if traj is None:
             self._command(self._hold, np.zeros(len(self.joints)))
             return
+        if self._t0 is None:
+            self._t0 = float(t)
         tau = t - self._t0 + self.dt
-        if not self._settled and tau - self.dt >= traj.duration and not self.busy(t):
-            self._settled = True
-            if not self._in_position():
-                off = self.tcp_pose().distance(self.kinematics.fk(traj.q_end)) * 1000 if self.kinematics else float("nan")
-                self.fault = (f"target {traj.name!r}: not reached {self.settle_timeout:g} s after the motion's end "
-                              f"(TCP {off:.1f} mm away; blocked?)")
         if tau >= traj.duration:
             self._hold = traj.q_end
             self._command(self._hold, np.zeros(len(self.joints)))
