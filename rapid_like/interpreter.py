@@ -254,7 +254,8 @@ class Interpreter:
                     w = next(gen)
                     if w.kind != "step":
                         gen.close()
-                        raise self.fail(f"FUNC {r.name} cannot wait ({w.what or w.kind})", e.span)
+                        raise self.fail(f"FUNC {r.name} cannot wait ({w.what or w.kind}): only a PROC can",
+                                        w.span or e.span)
             except StopIteration as stop:
                 return self.coerce(stop.value, r.return_type or "num", e.span)
         return self.builtin_function(e, f)
@@ -793,7 +794,7 @@ class Interpreter:
                             "ERR_INVALID_VALUE")
         until = self.now + to_ns(t)
         while self.now < until:
-            yield Wait("time", until, f"WaitTime {fmt_num(t)}")
+            yield Wait("time", until, f"WaitTime {fmt_num(t)}", s.span)
 
     def _wait_cond(self, s, arg, bound, test: Callable[[], bool], name: str, poll: int | None):
         maxtime = arg("maxtime")

@@ -21,6 +21,10 @@ from .tokens import Kind, Token
 _CLOSERS = {"ENDMODULE", "ENDPROC", "ENDFUNC", "ENDTRAP", "ENDIF", "ELSE", "ELSEIF", "ENDWHILE",
             "ENDFOR", "ENDTEST", "CASE", "DEFAULT", "ERROR"}
 _RELOPS = ("=", "<>", "<", "<=", ">", ">=")
+# The structure each closing word belongs to, for "ENDIF without IF" messages.
+_OWNER = {"ENDIF": "IF", "ELSE": "IF", "ELSEIF": "IF", "ENDWHILE": "WHILE", "ENDFOR": "FOR",
+          "ENDTEST": "TEST", "CASE": "TEST", "DEFAULT": "TEST", "ENDPROC": "PROC", "ENDFUNC": "FUNC",
+          "ERROR": "PROC or FUNC", "ENDMODULE": "MODULE", "ENDTRAP": "TRAP"}
 
 
 def parse(source: str, file: str = "<input>") -> n.Module:
@@ -34,6 +38,7 @@ class Parser:
         self.pos = 0
         self.source = source
         self.file = file
+        self.open_closers: list[tuple[str, ...]] = []  # closing words of the blocks being parsed
         self.line_starts = [0]
         for i, ch in enumerate(source):
             if ch == "\n":
@@ -219,13 +224,21 @@ class Parser:
         """Statements up to (not including) one of `closers`. Anything else that closes a block is
         reported as the missing `expected` word of `opener`."""
         stmts: list[n.Stmt] = []
-        while True:
-            t = self.tok
-            if t.kind is Kind.KEYWORD and t.upper in closers:
-                return stmts
-            if t.kind is Kind.EOF or (t.kind is Kind.KEYWORD and t.upper in _CLOSERS) or t.is_kw("PROC", "FUNC", "ENDMODULE"):
-                raise self.error(f"expected {expected} to close the {opener}, found {self.found()}")
-            stmts.append(self.statement())
+        self.open_closers.append(closers)
+        try:
+            while True:
+                t = self.tok
+                if t.kind is Kind.KEYWORD and t.upper in closers:
+                    return stmts
+                if t.kind is Kind.KEYWORD and t.upper in _CLOSERS and t.upper != "ENDMODULE" and \
+                        not any(t.upper in c for c in self.open_closers):
+                    raise self.error(f"{t.upper} without {_OWNER[t.upper]}: no {_OWNER[t.upper]} is open here")
+                if t.kind is Kind.EOF or (t.kind is Kind.KEYWORD and t.upper in _CLOSERS) or \
+                        t.is_kw("PROC", "FUNC", "ENDMODULE"):
+                    raise self.error(f"expected {expected} to close the {opener}, found {self.found()}")
+                stmts.append(self.statement())
+        finally:
+            self.open_closers.pop()
 
     def statement(self) -> n.Stmt:
         t = self.tok
@@ -313,6 +326,10 @@ class Parser:
                 need_comma = True
                 continue
             if need_comma and args and not args[-1].optional:
+                prev = self.toks[self.pos - 1]
+                if closer == ";" and t.span.line == prev.span.line:
+                    raise self.error(f"expected ',' between the arguments of {what}, found {self.found()}",
+                                     self.after_previous())
                 if closer == ";":
                     raise self.error(f"expected ';' at the end of the instruction, found {self.found()}",
                                      self.after_previous())
