@@ -1,5 +1,5 @@
 ! Two arguments without a comma between them.
-! error: 6:29 expected ',' between the arguments of the MoveJ instruction, found 'vmax'
+! error: 6:32 expected ',' between the arguments of the MoveJ instruction, found 'vmax'
 ! exit: 65
 MODULE Comma
   PROC main()
