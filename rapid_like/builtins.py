@@ -67,6 +67,8 @@ def predefined_data() -> dict[str, tuple[str, object]]:
     for name, num in ERRORS.items():
         data[name.lower()] = ("errnum", float(num))
     data["pi"] = ("num", math.pi)
+    data["high"] = ("dionum", 1.0)
+    data["low"] = ("dionum", 0.0)
     return data
 
 

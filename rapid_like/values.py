@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 
 NUM, BOOL, STRING = "num", "bool", "string"
-NUMERIC = {"num", "dnum", "errnum", "intnum"}
+NUMERIC = {"num", "dnum", "errnum", "intnum", "dionum"}
 ATOMIC = NUMERIC | {BOOL, STRING}
 SIGNAL_TYPES = {"signaldi": "DI", "signaldo": "DO", "signalai": "AI", "signalao": "AO",
                 "signalgi": "GI", "signalgo": "GO"}

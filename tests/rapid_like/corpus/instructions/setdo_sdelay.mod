@@ -7,7 +7,7 @@
 ! trace: {"t": 0.3, "type": "end", "reason": "completed"}
 MODULE Delayed
   PROC main()
-    SetDO \SDelay:=0.25, doClamp, 1;
+    SetDO \SDelay:=0.25, doClamp, high;
     TPWrite "set requested";
     WaitTime 0.1;
     TPWrite "doClamp=" \Num:=doClamp;
