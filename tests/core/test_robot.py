@@ -130,6 +130,19 @@ def test_rig_targets_with_the_tool_down_are_solved_within_a_tenth_of_a_millimetr
     assert all(lim.contains(v) for lim, v in zip(kin.limits, q))
 
 
+@pytest.mark.parametrize("deg", [[-119, 3, -97, 20, 16, -221], [-58, -2, -88, 165, 67, -23], [139, 4, -70, 125, -83, 140]])
+def test_a_reachable_target_far_from_the_seed_is_still_found(kin, deg):
+    target = kin.fk(np.radians(deg))
+    q = kin.ik(target, HOME, "far_from_home")
+    assert kin.fk(q).distance(target) < 1e-4 and kin.fk(q).angle(target) < math.radians(0.01)
+
+
+def test_ik_picks_the_turn_of_joint_6_nearest_the_seed(kin):
+    seed = np.radians([0, 0, 0, 0, 90, 300])
+    q = kin.ik(kin.fk(np.radians([0, 0, 0, 0, 90, -50])), seed, "turned")
+    assert math.degrees(q[5]) == pytest.approx(310, abs=0.01)
+
+
 def test_ik_is_deterministic_and_independent_of_earlier_queries(kin):
     target = down(1.6, 0.8, 0.3)
     first = kin.ik(target, HOME, "t")

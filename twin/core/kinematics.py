@@ -32,6 +32,9 @@ IK_TOL_ORI = math.radians(0.01)
 #: ... and fails with MotionError if it cannot get this close.
 IK_FAIL_POS = 1e-3
 IK_FAIL_ORI = math.radians(0.1)
+#: Restart seeds when the seed fails: joint_1 turned towards the wrist centre, then joint_2..6 in degrees.
+RESTART_POSES = ((0, 0, 0, 90, 0), (30, 30, 0, 30, 0), (-20, -60, 0, 60, 0), (0, 0, 0, -60, 0), (20, 0, 180, 60, 0))
+RESTART_ITERATIONS = 15
 
 
 @dataclass(frozen=True)
@@ -96,6 +99,11 @@ class ArmKinematics:
         self.upper = np.array([lim.upper for lim in self.limits])
         self.max_velocity = np.array([lim.velocity for lim in self.limits])
         self.n = len(self.joints)
+        # the wrist centre (joint_5's axis, on the forearm axis) seen from the flange, for IK restarts
+        wrist_link = self.joints[-2] if self.n >= 2 else self.flange
+        self._set(np.zeros(self.n))
+        w = c.getLinkState(self.body, wrist_link, computeForwardKinematics=True)[4]
+        self._wrist_in_flange = self._flange().inverse().transform(w)
 
     def close(self) -> None:
         try:
@@ -134,14 +142,26 @@ class ArmKinematics:
                 raise MotionError(target_name, f"would need {lim.name} beyond its limit ({math.degrees(v):.1f} deg, "
                                                f"range {math.degrees(lim.lower):.0f} to {math.degrees(lim.upper):.0f} deg)")
 
-    def ik(self, pose: Pose, seed_q: Iterable[float], target_name: str = "target", *,
+    def ik(self, pose: Pose, seed_q: Iterable[float], target_name: str = "target", *, restarts: bool = True,
            max_iterations: int = 40) -> np.ndarray:
-        """Joint positions that put the TCP at `pose`, near `seed_q`. Raises MotionError naming the target."""
+        """Joint positions that put the TCP at `pose`, near `seed_q`. Raises MotionError naming the target.
+
+        When the solve from the seed fails and `restarts` is true, a few fixed seeds (arm turned towards
+        the wrist centre, elbow and wrist in typical poses) are tried in order. Axes that turn more than
+        a full turn (joint_4, joint_6) get the solution's turn nearest the seed.
+        """
         seed = np.clip(self._as_q(seed_q), self.lower, self.upper)
         goal = pose * self._tool_inv
         q, err_p, err_o = self._solve(goal, seed, self.lower, self.upper, max_iterations)
         if err_p <= IK_FAIL_POS and err_o <= IK_FAIL_ORI:
-            return q
+            return self._nearest_turn(q, seed)
+        if restarts:
+            for start in self._restart_seeds(goal):
+                q2, p2, o2 = self._solve(goal, start, self.lower, self.upper, RESTART_ITERATIONS)
+                if p2 <= IK_FAIL_POS and o2 <= IK_FAIL_ORI:
+                    return self._nearest_turn(q2, seed)
+                if p2 + o2 < err_p + err_o:
+                    q, err_p, err_o = q2, p2, o2
         # Out of reach, or only beyond a joint limit? Solve again without the limits to tell.
         wide = np.full(self.n, 4.0 * math.pi)
         q_free, fp, fo = self._solve(goal, seed, -wide, wide, max_iterations)
@@ -150,6 +170,22 @@ class ArmKinematics:
         if err_p > IK_FAIL_POS:
             raise MotionError(target_name, f"cannot be reached: closest is {err_p * 1000:.1f} mm away")
         raise MotionError(target_name, f"cannot be reached: closest orientation is {math.degrees(err_o):.2f} deg away")
+
+    def _restart_seeds(self, goal: Pose) -> list[np.ndarray]:
+        wrist = self.base.inverse().transform(goal.transform(self._wrist_in_flange))
+        j1 = math.atan2(float(wrist[1]), float(wrist[0]))
+        seeds = [np.array([j1] + [math.radians(v) for v in rest]) for rest in RESTART_POSES]
+        return [np.clip(s, self.lower, self.upper) for s in seeds]
+
+    def _nearest_turn(self, q: np.ndarray, seed: np.ndarray) -> np.ndarray:
+        """Each angle turned by whole turns, within its range, to lie nearest the seed."""
+        out = q.copy()
+        for i, lim in enumerate(self.limits):
+            for k in (-2, -1, 1, 2):
+                cand = q[i] + 2 * math.pi * k
+                if lim.contains(cand) and abs(cand - seed[i]) < abs(out[i] - seed[i]):
+                    out[i] = cand
+        return out
 
     def _wrap(self, q: np.ndarray) -> np.ndarray:
         """Each angle turned by whole turns to lie in its joint's range, or else nearest the range's middle."""

@@ -172,7 +172,7 @@ def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callabl
     for i in range(1, n + 1):
         s = i / n
         try:
-            q = kin.ik(path(s), q_prev, name)
+            q = kin.ik(path(s), q_prev, name, restarts=False)
         except MotionError as exc:
             raise _on_path(exc, name, path(s), s) from None
         jump = np.abs(q - q_prev)
@@ -196,8 +196,8 @@ def _bridge(kin: ArmKinematics, path: Callable[[float], Pose], s0: float, s1: fl
     """A jump between two samples: solve the midpoint; raise if the arm really flips configuration."""
     sm = (s0 + s1) / 2
     try:
-        qm = kin.ik(path(sm), q0, name)
-        q1 = kin.ik(path(s1), qm, name)
+        qm = kin.ik(path(sm), q0, name, restarts=False)
+        q1 = kin.ik(path(s1), qm, name, restarts=False)
     except MotionError as exc:
         raise _on_path(exc, name, path(sm), sm) from None
     if np.max(np.abs(qm - q0)) <= MAX_JOINT_JUMP and np.max(np.abs(q1 - qm)) <= MAX_JOINT_JUMP:
