@@ -28,6 +28,8 @@ ERRORS = {
     "ERR_ROBLIMIT": 1010,
     "ERR_INVALID_VALUE": 1011,
     "ERR_NORUNUNIT": 1012,
+    "ERR_AO_LIM": 1013,
+    "ERR_GO_LIM": 1014,
 }
 ERR_NAMES = {v: k for k, v in ERRORS.items()}
 USER_ERRNO_BASE = 2000  # BookErrNo hands out numbers from here

@@ -273,6 +273,8 @@ class Interpreter:
                 yield from self.stmt(s, f)
                 return
             except ExecError as err:
+                if err.span is None:  # raised by the host (e.g. a setpoint out of range): blame the statement
+                    err.span = s.span
                 if f.in_handler:
                     raise Fatal(err) from None
                 if f.routine.error_handler is None:

@@ -203,3 +203,39 @@ def test_next_wake_reports_the_end_of_a_wait_and_pending_pulses():
     assert ctl.next_wake_ns() == 300_000_000
     ctl.tick(0.3)
     assert ctl.next_wake_ns() == 500_000_000
+
+
+class RefusingHost(InMemoryHost):
+    """A host that refuses analog setpoints above 441, as the cell does."""
+
+    def write_signal(self, name: str, value: float) -> None:
+        from rapid_like.builtins import ERRORS
+        from rapid_like.errors import ExecError
+        if value > 441:
+            raise ExecError(f"{name} = {value:g} is out of range (ERR_AO_LIM)", None, ERRORS["ERR_AO_LIM"],
+                            "ERR_AO_LIM")
+        super().write_signal(name, value)
+
+
+def test_host_errors_are_positioned_at_the_statement_and_can_be_handled():
+    host = RefusingHost([SignalInfo("aoAxis1", "AO")])
+    ctl, host, events = make("""MODULE M
+  PROC main()
+    SetAO aoAxis1, 500;
+    TPWrite "after";
+  ERROR
+    IF ERRNO = ERR_AO_LIM THEN
+      TPWrite "clamped";
+      SetAO aoAxis1, 441;
+      TRYNEXT;
+    ENDIF
+  ENDPROC
+ENDMODULE""", host=host)
+    ctl.tick(0.0)
+    assert [t for _, t in prints(events)] == ["clamped", "after"]
+    assert host.values["aoAxis1"] == 441
+
+    ctl2, _, events2 = make("MODULE M\n  PROC main()\n    SetAO aoAxis1, 500;\n  ENDPROC\nENDMODULE",
+                            host=RefusingHost([SignalInfo("aoAxis1", "AO")]))
+    ctl2.tick(0.0)
+    assert ctl2.state == "error" and (ctl2.error.span.line, ctl2.error.span.col) == (3, 5)
