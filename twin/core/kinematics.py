@@ -104,6 +104,9 @@ class ArmKinematics:
         self._set(np.zeros(self.n))
         w = c.getLinkState(self.body, wrist_link, computeForwardKinematics=True)[4]
         self._wrist_in_flange = self._flange().inverse().transform(w)
+        # calculateJacobian takes a point in the link's centre-of-mass frame: the flange frame's origin there
+        ls = c.getLinkState(self.body, self.flange)
+        self._flange_origin_in_com = Pose(ls[2], ls[3]).inverse().position.tolist()
 
     def close(self) -> None:
         try:
@@ -249,7 +252,7 @@ class ArmKinematics:
             s = math.sqrt(float(dq_rot[:3] @ dq_rot[:3]))
             w = (2.0 * math.atan2(s, dq_rot[3]) / s) * dq_rot[:3] if s > 1e-12 else 2.0 * dq_rot[:3]
             err = np.concatenate([goal.position - f.position, w])
-            jl, ja = c.calculateJacobian(self.body, self.flange, [0.0, 0.0, 0.0], q.tolist(), zeros, zeros)
+            jl, ja = c.calculateJacobian(self.body, self.flange, self._flange_origin_in_com, q.tolist(), zeros, zeros)
             jac = np.vstack([np.array(jl), np.array(ja)])
             lam2 = 1e-6
             dq = jac.T @ np.linalg.solve(jac @ jac.T + lam2 * np.eye(6), err)

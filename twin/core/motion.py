@@ -98,10 +98,12 @@ class Trajectory:
     """
 
     def __init__(self, kind: str, name: str, knots: np.ndarray, profile: Profile,
-                 path: Callable[[float], Pose] | None = None, tcp_path_length: float = 0.0):
+                 path: Callable[[float], Pose] | None = None, tcp_path_length: float = 0.0,
+                 s_knots: np.ndarray | None = None):
         self.kind, self.name = kind, name
-        self._knots = np.array(knots, dtype=float)  # shape (n+1, axes): q at s = i/n
+        self._knots = np.array(knots, dtype=float)  # shape (n + 1, axes): q at path parameter s_knots[i]
         self._n = len(self._knots) - 1
+        self._s = np.linspace(0.0, 1.0, self._n + 1) if s_knots is None else np.array(s_knots, dtype=float)
         self.profile = profile
         self.duration = profile.duration
         self.path = path
@@ -116,13 +118,14 @@ class Trajectory:
         return self._knots[-1].copy()
 
     def _at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """q and dq/ds at path parameter s (linear between knots)."""
         if self._n == 0:
             return self._knots[0].copy(), np.zeros(self._knots.shape[1])
-        x = s * self._n
-        i = min(int(x), self._n - 1)
-        f = x - i
+        i = min(max(int(np.searchsorted(self._s, s, side="right")) - 1, 0), self._n - 1)
+        s0, s1 = self._s[i], self._s[i + 1]
         a, b = self._knots[i], self._knots[i + 1]
-        return a + f * (b - a), (b - a) * self._n
+        f = (s - s0) / (s1 - s0)
+        return a + f * (b - a), (b - a) / (s1 - s0)
 
     def q(self, t: float) -> np.ndarray:
         s, _ = self.profile.s(t)
@@ -140,12 +143,15 @@ class Trajectory:
 
 
 # -- helpers -----------------------------------------------------------------------------------------
-def _joint_cruise(knots: np.ndarray, limits: Sequence[JointLimit], speed: Speed) -> float:
-    """Shortest cruise time in which no axis exceeds its speed limit (knots are uniform in s)."""
+def _joint_cruise(knots: np.ndarray, limits: Sequence[JointLimit], speed: Speed,
+                  s_knots: np.ndarray | None = None) -> float:
+    """Shortest cruise time (s runs at 1/cruise) in which no axis exceeds its speed limit."""
     if len(knots) < 2:
         return 0.0
+    if s_knots is None:
+        s_knots = np.linspace(0.0, 1.0, len(knots))
     vmax = np.array([lim.velocity for lim in limits]) * speed.joint_fraction
-    dq_ds = np.abs(np.diff(knots, axis=0)) * (len(knots) - 1)
+    dq_ds = np.abs(np.diff(knots, axis=0)) / np.diff(s_knots)[:, None]
     return float(np.max(dq_ds.max(axis=0) / vmax))
 
 
@@ -165,50 +171,46 @@ def _check_limits(q: np.ndarray, limits: Sequence[JointLimit], name: str) -> Non
 
 def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callable[[float], Pose], length: float,
                angle: float, speed: Speed, name: str) -> Trajectory:
-    """Solve IK along path(s), s in [0, 1], seeded sample to sample, and time it."""
+    """Solve IK along path(s), s in [0, 1], seeded sample to sample, and time it.
+
+    Where an axis moves more than MAX_JOINT_JUMP between two samples, the stretch is bisected (down to
+    1/16 of a sample); if it still jumps there, the arm would flip configuration and the move is refused.
+    """
     n = max(1, math.ceil(length / SAMPLE_STEP), math.ceil(angle / SAMPLE_ANGLE))
-    knots = [q_start]
-    q_prev = q_start
+    s_knots, knots = [0.0], [q_start]
     for i in range(1, n + 1):
-        s = i / n
-        try:
-            q = kin.ik(path(s), q_prev, name, restarts=False)
-        except MotionError as exc:
-            raise _on_path(exc, name, path(s), s) from None
-        jump = np.abs(q - q_prev)
-        if np.max(jump) > MAX_JOINT_JUMP:
-            q = _bridge(kin, path, (i - 1) / n, s, q_prev, name)
-        knots.append(q)
-        q_prev = q
-    knots_arr = np.array(knots)
-    cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots_arr, kin.limits, speed))
-    return Trajectory(kind, name, knots_arr, Profile(cruise, speed.ramp), path, length)
+        _sample(kin, path, (i - 1) / n, i / n, knots[-1], name, s_knots, knots, 0)
+    knots_arr, s_arr = np.array(knots), np.array(s_knots)
+    cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots_arr, kin.limits, speed, s_arr))
+    return Trajectory(kind, name, knots_arr, Profile(cruise, speed.ramp), path, length, s_arr)
 
 
-def _on_path(exc: MotionError, name: str, pose: Pose, s: float) -> MotionError:
-    reason = str(exc).removeprefix(f"target {name!r}: ")
-    p = pose.position * 1000
-    return MotionError(name, f"at ({p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f}) mm, {s * 100:.0f}% along the path: {reason}")
-
-
-def _bridge(kin: ArmKinematics, path: Callable[[float], Pose], s0: float, s1: float, q0: np.ndarray, name: str,
-            depth: int = 0) -> np.ndarray:
-    """A jump between two samples: solve the midpoint; raise if the arm really flips configuration."""
-    sm = (s0 + s1) / 2
+def _solve_at(kin: ArmKinematics, path: Callable[[float], Pose], s: float, seed: np.ndarray, name: str) -> np.ndarray:
     try:
-        qm = kin.ik(path(sm), q0, name, restarts=False)
-        q1 = kin.ik(path(s1), qm, name, restarts=False)
+        return kin.ik(path(s), seed, name, restarts=False)
     except MotionError as exc:
-        raise _on_path(exc, name, path(sm), sm) from None
-    if np.max(np.abs(qm - q0)) <= MAX_JOINT_JUMP and np.max(np.abs(q1 - qm)) <= MAX_JOINT_JUMP:
-        return q1
+        reason = str(exc).removeprefix(f"target {name!r}: ")
+        p = path(s).position * 1000
+        raise MotionError(name, f"at ({p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f}) mm, {s * 100:.0f}% along the path: "
+                                f"{reason}") from None
+
+
+def _sample(kin: ArmKinematics, path: Callable[[float], Pose], s0: float, s1: float, q0: np.ndarray, name: str,
+            s_knots: list, knots: list, depth: int) -> None:
+    """Append the knot at s1 (and, where an axis jumps, knots between s0 and s1)."""
+    q1 = _solve_at(kin, path, s1, q0, name)
+    if np.max(np.abs(q1 - q0)) <= MAX_JOINT_JUMP:
+        s_knots.append(s1)
+        knots.append(q1)
+        return
     if depth >= 4:
-        k = int(np.argmax(np.maximum(np.abs(qm - q0), np.abs(q1 - qm))))
-        p = path(sm).position * 1000
+        k = int(np.argmax(np.abs(q1 - q0)))
+        p = path(s1).position * 1000
         raise MotionError(name, f"the path passes a singularity near ({p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f}) mm: "
                                 f"{kin.joint_names[k]} would have to turn abruptly")
-    qm = _bridge(kin, path, s0, sm, q0, name, depth + 1)
-    return _bridge(kin, path, sm, s1, qm, name, depth + 1)
+    sm = (s0 + s1) / 2
+    _sample(kin, path, s0, sm, q0, name, s_knots, knots, depth + 1)
+    _sample(kin, path, sm, s1, knots[-1], name, s_knots, knots, depth + 1)
 
 
 # -- constructors ------------------------------------------------------------------------------------
