@@ -17,6 +17,7 @@ import json
 import sys
 from pathlib import Path
 
+from .controller import read_source
 from .errors import RapidError
 from .host import SIGNAL_KINDS, SignalInfo
 from .offline import SignalChange, run_offline
@@ -118,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     out, err = sys.stdout, sys.stderr
     path = Path(args.program)
     try:
-        source = path.read_text(encoding="utf-8")
+        source = read_source(path)
     except OSError as e:
         print(f"{args.program}: error: cannot read the program: {e.strerror or e}", file=err)
         return EX_NOINPUT

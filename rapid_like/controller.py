@@ -40,10 +40,18 @@ from .parser import parse
 RUNNING, WAITING, STOPPED, COMPLETED, ERROR = "running", "waiting", "stopped", "completed", "error"
 
 
+def read_source(path: str | Path) -> str:
+    """A .mod file's text: UTF-8 (with or without BOM), else Latin-1 as older controllers write it."""
+    data = Path(path).read_bytes()
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
 def load_program(path: str | Path) -> n.Module:
     """Read and parse a .mod file (raises LexError/ParseError)."""
-    path = Path(path)
-    return parse(path.read_text(encoding="utf-8"), str(path))
+    return parse(read_source(path), str(path))
 
 
 class Controller:
