@@ -2,8 +2,10 @@
 
 Stages, one per module, dependencies pointing one way:
 
-    tokens, lexer  ->  nodes, parser  ->  checker  ->  interpreter  ->  controller  ->  offline, cli
-                         values, builtins (types, predefined data, pure functions), errors, host
+    tokens, lexer  ->  nodes, parser  ->  checker  ->  interpreter (+ instructions, runtime)
+                   ->  controller  ->  offline, cli
+    shared: values (types, records), builtins (signatures, predefined data, pure functions),
+            errors (one base class with a span), host (the protocol the controller talks to)
 
 - `parser.parse(source, file)` gives a `nodes.Module` (hand-written recursive descent).
 - `checker.check(module, signals)` finds undefined names, arity and type errors before running.

@@ -228,6 +228,15 @@ def to_plain(v: object) -> object:
     return v
 
 
+def xyz(p: Record) -> tuple[float, float, float]:
+    """The components of a pos."""
+    return p.fields["x"], p.fields["y"], p.fields["z"]  # type: ignore[return-value]
+
+
+def pos(x: float, y: float, z: float) -> Record:
+    return Record("pos", {"x": x, "y": y, "z": z})
+
+
 def record(t: str, *items: object) -> Record:
     """Build a record from nested Python lists, e.g. record("pos", 1, 2, 3)."""
     return coerce(Aggregate(_agg(x) for x in items), t)  # type: ignore[return-value]

@@ -1,0 +1,127 @@
+"""Runtime structures shared by the evaluator and the built-in instructions: simulated time in
+integer nanoseconds, the `Wait` a suspended program yields, storage cells and references, call
+frames, and the exceptions that carry RETURN, EXIT, RETRY, TRYNEXT and errors between frames.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from . import nodes as n
+from .errors import ExecError, Span
+from .values import RECORDS, base_type
+
+NS = 1_000_000_000
+
+
+def to_ns(seconds: float) -> int:
+    return int(round(seconds * NS))
+
+
+@dataclass
+class Wait:
+    """What a suspended program waits for.
+
+    kind "time" / "poll": resume at the first tick with now >= at.
+    kind "step": a time-less loop iteration; resume at the next tick (or at `at` when set).
+    kind "signal" / "motion": re-evaluate on every tick; `at` (a timeout) is only a hint for
+    event-driven runners: nothing changes before `at` unless a signal does.
+    kind "stop": the program executed Stop; it waits for resume() or start().
+    """
+
+    kind: str
+    at: int | None = None
+    what: str = ""
+    span: Span | None = None
+
+
+# ---- control-flow signals (exceptions that are not errors) ------------------------------------
+class ReturnSignal(Exception):
+    def __init__(self, value: object = None):
+        self.value = value
+
+
+class ExitSignal(Exception):
+    """EXIT: the program ends."""
+
+
+class RetrySignal(Exception):
+    pass
+
+
+class TryNextSignal(Exception):
+    pass
+
+
+class Propagate(Exception):
+    """An error on its way to the caller's ERROR handler (passes through this routine's guards)."""
+
+    def __init__(self, error: ExecError):
+        self.error = error
+
+
+class Fatal(Exception):
+    """An error for the system error handler: the program stops with this error."""
+
+    def __init__(self, error: ExecError):
+        self.error = error
+
+
+# ---- storage -----------------------------------------------------------------------------------
+class Cell:
+    """A variable, persistent, constant or parameter. `value is ABSENT` for a missing optional."""
+
+    __slots__ = ("type", "value", "storage", "name")
+
+    def __init__(self, type_: str, value: object, storage: str = "VAR", name: str = ""):
+        self.type, self.value, self.storage, self.name = type_, value, storage, name
+
+    def get(self) -> object:
+        return self.value
+
+    def set(self, v: object) -> None:
+        self.value = v
+
+
+ABSENT = object()
+
+
+class Ref:
+    """A reference to a variable or one of its components (an INOUT argument, an assignment target)."""
+
+    __slots__ = ("cell", "path", "type", "name")
+
+    def __init__(self, cell, path: list[str], type_: str, name: str):
+        self.cell, self.path, self.type, self.name = cell, path, type_, name
+
+    @property
+    def storage(self) -> str:
+        return "VAR"
+
+    def get(self) -> object:
+        v = self.cell.get()
+        for k in self.path:
+            v = v.fields[k]  # type: ignore[union-attr]
+        return v
+
+    def set(self, v: object) -> None:
+        if not self.path:
+            self.cell.set(v)
+            return
+        obj = self.cell.get()
+        for k in self.path[:-1]:
+            obj = obj.fields[k]  # type: ignore[union-attr]
+        obj.fields[self.path[-1]] = v  # type: ignore[union-attr]
+
+
+@dataclass
+class Frame:
+    routine: n.Routine
+    vars: dict[str, object] = field(default_factory=dict)
+    in_handler: bool = False
+    error: ExecError | None = None
+
+
+def component_type(t: str, path: list[str]) -> str:
+    for k in path:
+        t = dict(RECORDS[base_type(t)])[k]
+    return t
