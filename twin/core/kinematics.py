@@ -51,6 +51,14 @@ class JointLimit:
         return self.lower - margin <= q <= self.upper + margin
 
 
+def check_limits(q: Iterable[float], limits: Sequence[JointLimit], target_name: str) -> None:
+    """MotionError naming the target (and the first joint) when a joint value is outside its range."""
+    for lim, v in zip(limits, q):
+        if not lim.contains(float(v)):
+            raise MotionError(target_name, f"would need {lim.name} beyond its limit ({math.degrees(v):.1f} deg, "
+                                           f"range {math.degrees(lim.lower):.0f} to {math.degrees(lim.upper):.0f} deg)")
+
+
 class ArmKinematics:
     """FK/IK of one arm: `fk(q) -> Pose` (TCP in the world), `ik(pose, seed_q, target_name) -> q`.
 
@@ -140,10 +148,7 @@ class ArmKinematics:
     # -- inverse kinematics ------------------------------------------------------------------------
     def check_limits(self, q: Iterable[float], target_name: str) -> None:
         """MotionError naming the target when a joint value is outside its range."""
-        for lim, v in zip(self.limits, self._as_q(q)):
-            if not lim.contains(float(v)):
-                raise MotionError(target_name, f"would need {lim.name} beyond its limit ({math.degrees(v):.1f} deg, "
-                                               f"range {math.degrees(lim.lower):.0f} to {math.degrees(lim.upper):.0f} deg)")
+        check_limits(self._as_q(q), self.limits, target_name)
 
     def ik(self, pose: Pose, seed_q: Iterable[float], target_name: str = "target", *, restarts: bool = True,
            max_iterations: int = 40) -> np.ndarray:

@@ -22,7 +22,7 @@ import numpy as np
 
 from .errors import MotionError
 from .geometry import Pose, slerp
-from .kinematics import ArmKinematics, JointLimit
+from .kinematics import ArmKinematics, JointLimit, check_limits
 
 #: Cartesian paths are solved at least every SAMPLE_STEP m and SAMPLE_ANGLE rad.
 SAMPLE_STEP = 0.005
@@ -162,13 +162,6 @@ def _as_q(q: Iterable[float], n: int, name: str, what: str) -> np.ndarray:
     return arr
 
 
-def _check_limits(q: np.ndarray, limits: Sequence[JointLimit], name: str) -> None:
-    for lim, v in zip(limits, q):
-        if not lim.contains(float(v)):
-            raise MotionError(name, f"would need {lim.name} beyond its limit ({math.degrees(v):.1f} deg, "
-                                    f"range {math.degrees(lim.lower):.0f} to {math.degrees(lim.upper):.0f} deg)")
-
-
 def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callable[[float], Pose], length: float,
                angle: float, speed: Speed, name: str) -> Trajectory:
     """Solve IK along path(s), s in [0, 1], seeded sample to sample, and time it.
@@ -229,7 +222,7 @@ def movej(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose | None
         q1 = kin.ik(target_pose, q0, name)
     else:
         q1 = _as_q(q_target, kin.n, name, "the target")
-        _check_limits(q1, kin.limits, name)
+        check_limits(q1, kin.limits, name)
     # TCP path length and rotation, sampled along the joint-space line
     steps = max(2, min(64, math.ceil(float(np.max(np.abs(q1 - q0))) / math.radians(2.0))))
     poses = [kin.fk(q0 + (q1 - q0) * (i / steps)) for i in range(steps + 1)]
@@ -253,7 +246,7 @@ def moveabsj(q_start: Iterable[float], q_target: Iterable[float], speed: Speed =
     n = len(joint_limits)
     q0 = _as_q(q_start, n, name, "the start")
     q1 = _as_q(q_target, n, name, "the target")
-    _check_limits(q1, joint_limits, name)
+    check_limits(q1, joint_limits, name)
     knots = np.array([q0, q1])
     return Trajectory("MoveAbsJ", name, knots, Profile(_joint_cruise(knots, joint_limits, speed), speed.ramp))
 
