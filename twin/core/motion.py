@@ -10,7 +10,8 @@ Timing: a path is followed at constant speed with a smooth ramp at both ends (ve
 cosine over `Speed.ramp` seconds, shortened for short moves). The cruise time is the longest of
 path length / v_tcp, reorientation angle / v_ori and, for every axis, what its speed limit
 (`JointLimit.velocity` x `Speed.joint_fraction`) allows: like a real controller, a move that would
-need an axis faster than it can go is slowed down, not refused.
+need an axis faster than it can go is slowed down, not refused. The whole move runs at one speed, so a
+MoveL passing close to a wrist singularity (joint_5 near 0) becomes slow from start to end.
 """
 from __future__ import annotations
 
