@@ -7,7 +7,8 @@
 `--io` plays the controller's I/O configuration (types DI, DO, AI, AO, GI, GO). Without --trace,
 TPWrite lines go to stdout; with --trace every observable event is one JSON object per line.
 Errors go to stderr as `FILE:LINE:COL: error: message` with the source line and a caret.
---max-time defaults to 3600 simulated seconds. Exit status: 0 for a run that ends normally (completed, exit, stop, time_limit), 65 for a syntax
+Without --max-time a run that is still going at 3600 simulated seconds ends there (time_limit),
+and a program waiting for a signal that nothing scheduled can change is an error. Exit status: 0 for a run that ends normally (completed, exit, stop, time_limit), 65 for a syntax
 or static error, 70 for a runtime error, 66 when the file cannot be read, 2 for a usage error.
 """
 from __future__ import annotations
@@ -20,11 +21,10 @@ from pathlib import Path
 from .controller import read_source
 from .errors import RapidError
 from .host import SIGNAL_KINDS, SignalInfo
-from .offline import SignalChange, run_offline
+from .offline import DEFAULT_TIME_LIMIT, SignalChange, run_offline
 from .parser import parse
 
 EX_OK, EX_USAGE, EX_DATAERR, EX_NOINPUT, EX_SOFTWARE = 0, 2, 65, 66, 70
-DEFAULT_MAX_TIME = 3600.0  # simulated seconds
 
 
 class UsageError(Exception):
@@ -93,9 +93,10 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--entry", default="main", help="routine to start from (default: main)")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="NAME=VALUE[@T]",
                      help="set a signal at simulated time T seconds (default 0); repeatable")
-    run.add_argument("--max-time", type=float, default=DEFAULT_MAX_TIME, metavar="T",
-                     help="end the run at simulated time T, reason time_limit (default "
-                          f"{DEFAULT_MAX_TIME:g} s, so a program that never ends cannot hang the shell)")
+    run.add_argument("--max-time", type=float, default=None, metavar="T",
+                     help="end the run at simulated time T, reason time_limit (without it: a program "
+                          f"still running at {DEFAULT_TIME_LIMIT:g} s ends there, and one that waits for "
+                          "a signal nothing changes is an error)")
     run.add_argument("--step", type=float, default=0.012, metavar="S",
                      help="simulated time of a loop iteration that waits for nothing (default 0.012)")
     run.add_argument("--trace", action="store_true", help="print every event as one JSON object per line")

@@ -34,11 +34,18 @@ class Outcome:
     events: list[dict] = field(default_factory=list)
 
 
+DEFAULT_TIME_LIMIT = 3600.0
+
+
 def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[SignalChange] = (),
                 entry: str = "main", max_time: float | None = None, step: float = 0.012,
-                on_event: Callable[[dict], None] | None = None) -> Outcome:
+                on_event: Callable[[dict], None] | None = None,
+                default_limit: float = DEFAULT_TIME_LIMIT) -> Outcome:
     """Run `module` from `entry` until it ends, fails or `max_time` passes. Raises CheckError for
-    static errors (nothing has run then)."""
+    static errors (nothing has run then).
+
+    Without `max_time`, a program that waits for something nothing scheduled can change is a
+    runtime error ("waits forever"), and one that keeps running ends at `default_limit`."""
     events: list[dict] = []
 
     def emit(ev: dict) -> None:
@@ -51,6 +58,7 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
     pending = sorted(((to_ns(c.t), i, c) for i, c in enumerate(changes)), key=lambda x: (x[0], x[1]))
     ctl = Controller(module, host, entry, on_event=emit, step=step)
     limit = None if max_time is None else to_ns(max_time)
+    fallback = to_ns(default_limit)
 
     def apply(now: int) -> None:
         while pending and pending[0][0] <= now:
@@ -74,8 +82,9 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
             ctl._fail(err)
             return Outcome("error", now / NS, err, host, events)
         nxt = max(min(times), now + 1)
-        if limit is not None and nxt > limit:
-            now = limit
+        end = limit if limit is not None else fallback
+        if nxt > end:
+            now = end
             break
         now = nxt
         apply(now)
