@@ -2,17 +2,27 @@
 
 `!` starts a comment that runs to the end of the line. Strings are double-quoted; a quote inside a
 string is written twice (`""`) and a backslash as `\\\\`. Numbers are decimal, with an optional
-fraction and exponent (`9E9`, `1.5e-3`).
+fraction and exponent (`9E9`, `1.5e-3`). An old-style `%%% VERSION:1 LANGUAGE:ENGLISH %%%` header
+at the top of a file is skipped.
 """
 from __future__ import annotations
 
+import re
+
 from .errors import LexError, Span
 from .tokens import KEYWORDS, OPERATORS, Kind, Token
+
+_HEADER = re.compile(r"\s*%%%.*?%%%", re.S)
 
 
 def lex(source: str, file: str = "<input>") -> list[Token]:
     tokens: list[Token] = []
     i, line, line_start, n = 0, 1, 0, len(source)
+    header = _HEADER.match(source)  # an old-style `%%% VERSION:1 LANGUAGE:ENGLISH %%%` file header
+    if header:
+        i = header.end()
+        line += source.count("\n", 0, i)
+        line_start = source.rfind("\n", 0, i) + 1
 
     def span_at(pos: int) -> Span:
         return Span(file, line, pos - line_start + 1)
