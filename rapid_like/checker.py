@@ -16,7 +16,7 @@ from . import builtins as B
 from . import nodes as n
 from .errors import CheckError, Span
 from .host import SignalInfo
-from .values import ATOMIC, KNOWN_TYPES, NUMERIC, RECORDS, SIGNAL_TYPES, base_type
+from .values import ATOMIC, KNOWN_TYPES, NUMERIC, RECORDS, SIGNAL_TYPES, array_type, base_type, split_array_type
 
 ANY = None  # unknown type: do not complain
 
@@ -88,6 +88,9 @@ class Checker:
     def check_type_name(self, t: str, span: Span, allow_signals: bool = False) -> None:
         if t == "switch":
             return
+        arr = split_array_type(t)
+        if arr:
+            t = arr[0]
         if t not in KNOWN_TYPES or (t in SIGNAL_TYPES and not allow_signals):
             close = difflib.get_close_matches(t, sorted(KNOWN_TYPES), n=1)
             hint = f" (did you mean {close[0]}?)" if close else ""
@@ -95,6 +98,13 @@ class Checker:
                 raise self.err(f"signals are configured in the controller's I/O, not declared as data: "
                                f"{t} can only be a parameter type", span)
             raise self.err(f"unknown data type '{t}'{hint}", span)
+
+    def decl_type(self, d: n.DataDecl, scope: dict[str, Sym]) -> str:
+        """A declaration's type; `num{}` etc. for arrays, whose sizes must be nums."""
+        self.check_type_name(d.type, d.type_span)
+        for e in d.dims:
+            self.expect_type(e, "num", scope, what="an array size")
+        return array_type(d.type, len(d.dims)) if d.dims else d.type
 
     # ---- module --------------------------------------------------------------------------------
     def run(self) -> None:
@@ -104,14 +114,14 @@ class Checker:
                                f"{self.routines[r.key].span.line})", r.span)
             self.routines[r.key] = r
         for d in self.module.data:
-            self.check_type_name(d.type, d.type_span)
+            dtype = self.decl_type(d, {})
             if d.key in self.globals or d.key in self.routines:
                 raise self.err(f"{d.name} is declared twice", d.span)
             if d.key in self.signals:
                 raise self.err(f"{d.name} is already a configured I/O signal", d.span)
             if d.init is not None:
-                self.expect_type(d.init, d.type, {})
-            self.globals[d.key] = Sym("data", d.type, d.storage, name=d.name)
+                self.expect_type(d.init, dtype, {})
+            self.globals[d.key] = Sym("data", dtype, d.storage, name=d.name)
         for r in self.module.routines:
             self.routine(r)
 
@@ -142,12 +152,12 @@ class Checker:
     def stmt(self, s: n.Stmt, scope: dict[str, Sym], h: bool) -> None:
         if isinstance(s, n.LocalDecl):
             d = s.decl
-            self.check_type_name(d.type, d.type_span)
+            dtype = self.decl_type(d, scope)
             if d.key in scope:
                 raise self.err(f"{d.name} is declared twice in {self.current.name}", d.span)
             if d.init is not None:
-                self.expect_type(d.init, d.type, scope)
-            scope[d.key] = Sym("data", d.type, d.storage, name=d.name)
+                self.expect_type(d.init, dtype, scope)
+            scope[d.key] = Sym("data", dtype, d.storage, name=d.name)
         elif isinstance(s, n.Assign):
             ttype = self.assign_target(s.target, scope)
             self.expect_type(s.value, ttype, scope)
@@ -206,7 +216,7 @@ class Checker:
 
     def assign_target(self, target: n.Expr, scope: dict[str, Sym]) -> str | None:
         root = target
-        while isinstance(root, n.Component):
+        while isinstance(root, (n.Component, n.Index)):
             root = root.obj
         assert isinstance(root, n.Name)
         sym = self.lookup(root.name, scope)
@@ -264,7 +274,11 @@ class Checker:
             if p.type in SIGNAL_TYPES:
                 self.signal_arg(name, p, a.value, scope)
             elif p.type == "any":
-                if name.lower() == "present":
+                if name.lower() == "dim":
+                    t = self.value_type(a.value, scope)
+                    if t is not None and not split_array_type(t):
+                        raise self.err(f"Dim needs an array, {a.value.text} is a {t}", a.value.span)
+                elif name.lower() == "present":
                     if not (isinstance(a.value, n.Name) and self.lookup(a.value.name, scope)
                             and self.lookup(a.value.name, scope).kind in ("param", "switch", "signal")
                             and a.value.key in scope):
@@ -273,7 +287,7 @@ class Checker:
                 else:
                     self.value_type(a.value, scope)
             elif p.mode in ("INOUT", "VAR", "PERS"):
-                if not isinstance(a.value, (n.Name, n.Component)):
+                if not isinstance(a.value, (n.Name, n.Component, n.Index)):
                     raise self.err(f"{name}: argument {p.name} must be a variable (it is {p.mode})", a.value.span)
                 t = self.assign_target(a.value, scope)
                 if t is not None and base_type(t) != base_type(p.type):
@@ -310,6 +324,15 @@ class Checker:
         if want == got:
             if want == "aggregate":
                 return True
+            return True
+        if got == "aggregate" and split_array_type(want):
+            assert isinstance(e, n.Aggregate)
+            elem, ndims = split_array_type(want)  # type: ignore[misc]
+            inner = elem if ndims == 1 else array_type(elem, ndims - 1)
+            for item in e.items:
+                it = "aggregate" if isinstance(item, n.Aggregate) else self.value_type(item, scope)
+                if it is not None and not self.compatible(inner, it, item, scope):
+                    raise self.err(f"type mismatch in an array element: expected {inner}, found {it}", item.span)
             return True
         if got == "aggregate" and want in RECORDS:
             assert isinstance(e, n.Aggregate)
@@ -352,11 +375,29 @@ class Checker:
             if sym.kind == "switch":
                 raise self.err(f"{e.name} is a switch: test it with Present({e.name})", e.span)
             return sym.type
+        if isinstance(e, n.Index):
+            t = self.value_type(e.obj, scope)
+            for i in e.indices:
+                self.expect_type(i, "num", scope, what="an array index")
+            if t is None:
+                return None
+            arr = split_array_type(t)
+            if not arr:
+                raise self.err(f"{e.obj.text} is a {t}, not an array: it cannot be indexed", e.indices[0].span)
+            elem, ndims = arr
+            if len(e.indices) != ndims:
+                raise self.err(f"{e.obj.text} has {ndims} dimension{'s' if ndims > 1 else ''}, "
+                               f"{len(e.indices)} ind{'ices' if len(e.indices) > 1 else 'ex'} given",
+                               e.indices[0].span)
+            return elem
         if isinstance(e, n.Component):
             t = self.value_type(e.obj, scope)
             if t is None:
                 return None
             t = base_type(t)
+            if split_array_type(t):
+                raise self.err(f"{e.obj.text} is an array: index it first, e.g. {e.obj.text}{{1}}.{e.field}",
+                               e.field_span)
             if t not in RECORDS:
                 raise self.err(f"{e.obj.text} is a {t} and has no components", e.field_span)
             for fname, ftype in RECORDS[t]:
@@ -444,7 +485,7 @@ _PROPER = {k.lower(): k for k in (
     "Incr Decr Add SetDO SetAO SetGO Set Reset InvertDO PulseDO WaitTime WaitDI WaitDO WaitUntil WaitRob TPWrite "
     "TPErase MoveJ MoveL MoveC MoveAbsJ Stop Break ConfJ ConfL VelSet AccSet BookErrNo Offs RelTool CRobT "
     "CJointT Present Abs Round Trunc Sqrt Pow Exp Sin Cos Tan ATan ATan2 NumToStr ValToStr StrLen StrPart "
-    "Dist DOutput DInput AOutput GOutput TestDI ClkReset ClkStart ClkStop ClkRead").split()}
+    "Dist DOutput DInput AOutput GOutput TestDI ClkReset ClkStart ClkStop ClkRead Dim").split()}
 
 
 def _proper(key: str) -> str:

@@ -106,6 +106,13 @@ class InstructionsMixin:
                 return B.dist(vals[0], vals[1])
             if key == "clkread":
                 return x.read(self.now)
+            if key == "dim":
+                sizes = x.sizes() if isinstance(x, list) and hasattr(x, "sizes") else []
+                d = int(vals[1])
+                if not 1 <= d <= len(sizes):
+                    raise self.fail(f"Dim: the array has {len(sizes)} dimension(s), not {fmt_num(vals[1])}",
+                                    e.span, "ERR_OUTOFBND")
+                return float(sizes[d - 1])
         except (ValueError, OverflowError) as exc:
             raise self.fail(f"{e.name}: {exc}", e.span, "ERR_INVALID_VALUE") from None
         raise self.fail(f"function {e.name} is not implemented", e.span)  # pragma: no cover

@@ -25,8 +25,8 @@ from .host import Host, SignalInfo
 from .instructions import InstructionsMixin
 from .runtime import (ABSENT, NS, Cell, ExitSignal, Fatal, Frame, Propagate, Ref, RetrySignal, ReturnSignal,
                       TryNextSignal, Wait, component_type, to_ns)
-from .values import (SIGNAL_KINDS, SIGNAL_TYPES, Aggregate, Record, SignalRef, TypeMismatch, coerce, default_value,
-                     describe_type, fmt_num, json_num, pos, xyz)
+from .values import (SIGNAL_KINDS, SIGNAL_TYPES, Aggregate, Array, Record, SignalRef, TypeMismatch, array_type,
+                     coerce, default_value, describe_type, fmt_num, json_num, new_array, pos, xyz)
 
 __all__ = ["Interpreter", "Wait", "NS", "to_ns", "ExitSignal", "Fatal", "Propagate"]
 
@@ -60,8 +60,28 @@ class Interpreter(InstructionsMixin):
             if keep_pers and d.storage == "PERS" and d.key in old:
                 self.globals[d.key] = old[d.key]
                 continue
-            value = self.coerce(self.eval(d.init, top), d.type, d.init.span) if d.init else default_value(d.type)
-            self.globals[d.key] = Cell(d.type, value, d.storage, d.name)
+            self.globals[d.key] = self.declare(d, top)
+
+    def declare(self, d: n.DataDecl, f: Frame) -> Cell:
+        """A new cell for a declaration, with its initial value (arrays get their declared sizes)."""
+        if not d.dims:
+            value = self.coerce(self.eval(d.init, f), d.type, d.init.span) if d.init else default_value(d.type)
+            return Cell(d.type, value, d.storage, d.name)
+        sizes = []
+        for e in d.dims:
+            size = self.num(e, f)
+            if size != int(size) or size < 1:
+                raise self.fail(f"an array size must be a whole number >= 1, not {fmt_num(size)}", e.span)
+            sizes.append(int(size))
+        t = array_type(d.type, len(sizes))
+        if d.init is None:
+            return Cell(t, new_array(d.type, sizes), d.storage, d.name)
+        value = self.coerce(self.eval(d.init, f), t, d.init.span)
+        if value.sizes() != sizes:  # type: ignore[union-attr]
+            raise self.fail(f"{d.name} is declared with {{{', '.join(map(str, sizes))}}} elements, the "
+                            f"initial value has {{{', '.join(map(str, value.sizes()))}}}",  # type: ignore[union-attr]
+                            d.init.span)
+        return Cell(t, value, d.storage, d.name)
 
     def run(self, entry: str) -> Generator[Wait, None, None]:
         r = self.routines[entry.lower()]
@@ -199,7 +219,13 @@ class Interpreter(InstructionsMixin):
             yield from self.proc_call(s, f)
         elif isinstance(s, n.Assign):
             ref = self.lvalue(s.target, f)
-            ref.set(self.coerce(self.eval(s.value, f), ref.type, s.value.span))
+            value = self.coerce(self.eval(s.value, f), ref.type, s.value.span)
+            if isinstance(value, Array):
+                old = ref.get()
+                if isinstance(old, Array) and old.sizes() != value.sizes():
+                    raise self.fail(f"type mismatch: {s.target.text} has {{{', '.join(map(str, old.sizes()))}}} "
+                                    f"elements, the value {{{', '.join(map(str, value.sizes()))}}}", s.value.span)
+            ref.set(value)
         elif isinstance(s, n.If):
             for cond, body in s.branches:
                 if self.truth(cond, f):
@@ -227,9 +253,7 @@ class Interpreter(InstructionsMixin):
             if s.default is not None:
                 yield from self.block(s.default, f)
         elif isinstance(s, n.LocalDecl):
-            d = s.decl
-            value = self.coerce(self.eval(d.init, f), d.type, d.init.span) if d.init else default_value(d.type)
-            f.vars[d.key] = Cell(d.type, value, d.storage, d.name)
+            f.vars[s.decl.key] = self.declare(s.decl, f)
         elif isinstance(s, n.Return):
             value = None
             if s.value is not None:
@@ -314,9 +338,14 @@ class Interpreter(InstructionsMixin):
                                 e.span, "ERR_ARGNOTPER")
             if isinstance(v, SignalRef):
                 return float(self.host.read_signal(v.name))
-            if isinstance(v, Record):
+            if isinstance(v, (Record, Array)):
                 return v.copy()
             return v
+        if isinstance(e, n.Index):
+            arr = self.eval(e.obj, f)
+            for k in self.indexes(e, arr, f):
+                arr = arr[k]  # type: ignore[index]
+            return arr
         if isinstance(e, n.Component):
             obj = self.eval(e.obj, f)
             if not isinstance(obj, Record) or e.field.lower() not in obj.fields:
@@ -416,20 +445,44 @@ class Interpreter(InstructionsMixin):
         raise self.fail(f"type mismatch: {op} is not defined for {ta} and {tb}", e.op_span)
 
     def lvalue(self, e: n.Expr, f: Frame) -> Ref:
-        path: list[str] = []
+        steps: list[n.Expr] = []
         root = e
-        while isinstance(root, n.Component):
-            path.insert(0, root.field.lower())
+        while isinstance(root, (n.Component, n.Index)):
+            steps.insert(0, root)
             root = root.obj
         assert isinstance(root, n.Name)
         cell = self.lookup(root.name, f, root.span)
         if cell.storage == "CONST":
             raise self.fail(f"cannot assign to the constant {root.name}", root.span)
+        path: list = []
+        value = cell.get()
+        for step in steps:
+            if isinstance(step, n.Component):
+                path.append(step.field.lower())
+                value = value.fields[path[-1]] if isinstance(value, Record) else None
+            else:
+                for k in self.indexes(step, value, f):
+                    path.append(k)
+                    value = value[k]  # type: ignore[index]
         try:
             t = component_type(cell.type, path)
-        except KeyError:
+        except (KeyError, TypeError):
             raise self.fail(f"{cell.type} has no component '{path[-1]}'", e.span) from None
         return Ref(cell, path, t, e.text)
+
+    def indexes(self, e: n.Index, arr: object, f: Frame) -> list[int]:
+        """0-based indexes of `e` into `arr`, checked against its bounds (ERR_OUTOFBND)."""
+        out = []
+        for i in e.indices:
+            if not isinstance(arr, Array):
+                raise self.fail(f"{e.obj.text} has fewer dimensions than indices", i.span)
+            k = self.num(i, f)
+            if k != int(k) or not 1 <= k <= len(arr):
+                raise self.fail(f"index {fmt_num(k)} is outside {e.obj.text}{{1..{len(arr)}}}", i.span,
+                                "ERR_OUTOFBND")
+            out.append(int(k) - 1)
+            arr = arr[int(k) - 1]
+        return out
 
     def signal_arg(self, e: n.Expr | None, f: Frame, kind: str) -> SignalRef:
         if not isinstance(e, n.Name):

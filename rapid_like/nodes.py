@@ -51,6 +51,14 @@ class Component(Expr):
 
 
 @dataclass
+class Index(Expr):
+    """`array{i}` or `array{i, j}` (1-based)."""
+
+    obj: Expr
+    indices: list[Expr]
+
+
+@dataclass
 class Unary(Expr):
     op: str  # "-", "+", "NOT"
     operand: Expr
@@ -192,6 +200,7 @@ class DataDecl:
     name: str
     init: Expr | None = None
     local: bool = False
+    dims: list[Expr] = field(default_factory=list)  # array sizes, e.g. {3} or {2, 3}
 
     @property
     def key(self) -> str:

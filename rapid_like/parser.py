@@ -16,6 +16,7 @@ from . import nodes as n
 from .errors import ParseError, Span
 from .lexer import lex
 from .tokens import Kind, Token
+from .values import array_type
 
 # Words that close a block; a statement never starts with one of them.
 _CLOSERS = {"ENDMODULE", "ENDPROC", "ENDFUNC", "ENDTRAP", "ENDIF", "ELSE", "ELSEIF", "ENDWHILE",
@@ -148,8 +149,16 @@ class Parser:
         ttok = self.expect_ident(f"a data type after {storage}")
         name = self.expect_ident(f"a name for the {ttok.text} {storage.lower()}iable" if storage == "VAR"
                                  else f"a name for the {ttok.text} {storage}")
+        dims: list[n.Expr] = []
         if self.tok.is_op("{"):
-            raise self.error("arrays are not supported by this interpreter")
+            brace = self.advance()
+            dims.append(self.expression())
+            while self.tok.is_op(","):
+                self.advance()
+                dims.append(self.expression())
+            self.expect_op("}", f" to close the array size on line {brace.span.line} col {brace.span.col}")
+            if len(dims) > 3:
+                raise self.error("an array has at most 3 dimensions", brace.span)
         init = None
         if self.tok.is_op(":="):
             self.advance()
@@ -159,7 +168,7 @@ class Parser:
         elif storage == "CONST":
             raise self.error(f"expected ':=' and a value for the constant {name.text}", self.after_previous())
         self.expect_op(";", " at the end of the declaration", at_previous=True)
-        return n.DataDecl(kw.span, storage, ttok.text.lower(), ttok.span, name.text, init, local)
+        return n.DataDecl(kw.span, storage, ttok.text.lower(), ttok.span, name.text, init, local, dims)
 
     def routine(self, local: bool) -> n.Routine:
         kw = self.advance()
@@ -215,9 +224,19 @@ class Parser:
             name = self.expect_ident("a switch name")
             return n.Param(start.span, name.text, "switch", mode, True)
         name = self.expect_ident(f"a parameter name after the type {ttok.text}")
-        if self.tok.is_op("{"):
-            raise self.error("array parameters are not supported by this interpreter")
-        return n.Param(start.span, name.text, ttok.text.lower(), mode, optional)
+        ptype = ttok.text.lower()
+        if self.tok.is_op("{"):  # an array parameter: {*}, {*,*} or {*,*,*}
+            self.advance()
+            ndims = 0
+            while True:
+                self.expect_op("*", " in an array parameter's dimensions ({*})")
+                ndims += 1
+                if not self.tok.is_op(","):
+                    break
+                self.advance()
+            self.expect_op("}", " to close the array parameter's dimensions")
+            ptype = array_type(ptype, ndims)
+        return n.Param(start.span, name.text, ptype, mode, optional)
 
     # ---- statements ------------------------------------------------------------------------------
     def block(self, closers: tuple[str, ...], expected: str, opener: str) -> list[n.Stmt]:
@@ -279,7 +298,7 @@ class Parser:
 
     def simple_ident_statement(self) -> n.Stmt:
         start = self.tok
-        if self.peek().is_op(":=", "."):
+        if self.peek().is_op(":=", ".", "{"):
             target = self.postfix(self.name_expr())
             if not self.tok.is_op(":="):
                 if self.tok.is_op("="):
@@ -289,8 +308,6 @@ class Parser:
             value = self.expression()
             self.end_of_instruction()
             return n.Assign(start.span, target, value)
-        if self.peek().is_op("{"):
-            raise self.error("arrays are not supported by this interpreter", self.peek().span)
         if self.peek().is_op("=") and not self.peek(2).is_op("="):
             raise self.error(f"expected ':=' to assign to {start.text} ('=' compares)", self.peek().span)
         name = self.advance()
@@ -534,10 +551,18 @@ class Parser:
         return n.Name(t.span, t.text, t.text)
 
     def postfix(self, expr: n.Expr) -> n.Expr:
-        """`expr.field.field ...`"""
+        """`expr.field`, `expr{i}`, `expr{i, j}`, in any sequence."""
         start = self.line_starts[expr.span.line - 1] + expr.span.col - 1
-        while self.tok.is_op("."):
-            self.advance()
-            f = self.expect_ident("a component name after '.'")
-            expr = n.Component(expr.span, self.source[start:f.end], expr, f.text, f.span)
+        while self.tok.is_op(".", "{"):
+            if self.advance().text == ".":
+                f = self.expect_ident("a component name after '.'")
+                expr = n.Component(expr.span, self.source[start:f.end], expr, f.text, f.span)
+            else:
+                brace = self.toks[self.pos - 1]
+                indices = [self.expression()]
+                while self.tok.is_op(","):
+                    self.advance()
+                    indices.append(self.expression())
+                close = self.expect_op("}", f" to close the index on line {brace.span.line} col {brace.span.col}")
+                expr = n.Index(expr.span, self.source[start:close.end], expr, indices)
         return expr

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 from . import nodes as n
 from .errors import ExecError, Span
-from .values import RECORDS, base_type
+from .values import RECORDS, array_type, base_type, split_array_type
 
 NS = 1_000_000_000
 
@@ -90,7 +90,7 @@ class Ref:
 
     __slots__ = ("cell", "path", "type", "name")
 
-    def __init__(self, cell, path: list[str], type_: str, name: str):
+    def __init__(self, cell, path: list, type_: str, name: str):
         self.cell, self.path, self.type, self.name = cell, path, type_, name
 
     @property
@@ -100,7 +100,7 @@ class Ref:
     def get(self) -> object:
         v = self.cell.get()
         for k in self.path:
-            v = v.fields[k]  # type: ignore[union-attr]
+            v = v[k] if isinstance(k, int) else v.fields[k]  # type: ignore[union-attr,index]
         return v
 
     def set(self, v: object) -> None:
@@ -109,8 +109,12 @@ class Ref:
             return
         obj = self.cell.get()
         for k in self.path[:-1]:
-            obj = obj.fields[k]  # type: ignore[union-attr]
-        obj.fields[self.path[-1]] = v  # type: ignore[union-attr]
+            obj = obj[k] if isinstance(k, int) else obj.fields[k]  # type: ignore[union-attr,index]
+        last = self.path[-1]
+        if isinstance(last, int):
+            obj[last] = v  # type: ignore[index]
+        else:
+            obj.fields[last] = v  # type: ignore[union-attr]
 
 
 @dataclass
@@ -121,7 +125,12 @@ class Frame:
     error: ExecError | None = None
 
 
-def component_type(t: str, path: list[str]) -> str:
+def component_type(t: str, path: list) -> str:
+    """The type of `path` (component names, and 0-based indexes as ints) inside a `t`."""
     for k in path:
-        t = dict(RECORDS[base_type(t)])[k]
+        if isinstance(k, int):
+            elem, ndims = split_array_type(t)  # type: ignore[misc]
+            t = elem if ndims == 1 else array_type(elem, ndims - 1)
+        else:
+            t = dict(RECORDS[base_type(t)])[k]
     return t

@@ -83,6 +83,43 @@ class Clock:
         return c
 
 
+class Array(list):
+    """An array value: `elem` is the element type; a 2- or 3-dimensional array nests Arrays."""
+
+    def __init__(self, elem: str, items=()):
+        super().__init__(items)
+        self.elem = elem
+
+    def copy(self) -> "Array":  # type: ignore[override]
+        return Array(self.elem, (x.copy() if isinstance(x, (Record, Array, Clock)) else x for x in self))
+
+    @property
+    def ndims(self) -> int:
+        return 1 + (self[0].ndims if self and isinstance(self[0], Array) else 0)
+
+    def sizes(self) -> list[int]:
+        return [len(self)] + (self[0].sizes() if self and isinstance(self[0], Array) else [])
+
+
+def array_type(elem: str, ndims: int) -> str:
+    """The type name of an array: `num{}`, `num{,}`, `num{,,}`."""
+    return f"{elem}{{{',' * (ndims - 1)}}}"
+
+
+def split_array_type(t: str) -> tuple[str, int] | None:
+    """(element type, dimensions) of an array type name, None for any other type."""
+    if t.endswith("}") and "{" in t:
+        elem, dims = t[:-1].split("{", 1)
+        return elem, dims.count(",") + 1
+    return None
+
+
+def new_array(elem: str, sizes: list[int]) -> Array:
+    if len(sizes) == 1:
+        return Array(elem, (default_value(elem) for _ in range(sizes[0])))
+    return Array(elem, (new_array(elem, sizes[1:]) for _ in range(sizes[0])))
+
+
 class Aggregate(list):
     """An untyped aggregate `[...]` before it is given a type."""
 
@@ -100,6 +137,9 @@ class TypeMismatch(Exception):
 
 
 def base_type(t: str) -> str:
+    if t.endswith("}") and "{" in t:
+        elem, dims = t[:-1].split("{", 1)
+        return f"{base_type(elem)}{{{dims}}}"
     return NUM if t in NUMERIC else t
 
 
@@ -131,6 +171,8 @@ def type_of(v: object) -> str:
         return SIGNAL_KINDS[v.kind]
     if isinstance(v, Clock):
         return "clock"
+    if isinstance(v, Array):
+        return array_type(v.elem, v.ndims)
     if isinstance(v, Aggregate):
         return "aggregate"
     return type(v).__name__
@@ -169,6 +211,20 @@ def coerce(v: object, t: str) -> object:
     elif t in SIGNAL_TYPES:
         if isinstance(v, SignalRef) and v.kind == SIGNAL_TYPES[t]:
             return v
+    elif split_array_type(t):
+        elem, ndims = split_array_type(t)  # type: ignore[misc]
+        if isinstance(v, Array):
+            if base_type(v.elem) == base_type(elem) and v.ndims == ndims:
+                return v.copy()
+        elif isinstance(v, Aggregate):
+            inner = elem if ndims == 1 else array_type(elem, ndims - 1)
+            out = []
+            for i, item in enumerate(v, 1):
+                try:
+                    out.append(coerce(item, inner))
+                except TypeMismatch as e:
+                    raise TypeMismatch(f"element {i}: {e}") from None
+            return Array(elem, out)
     raise TypeMismatch(f"expected {t}, found {describe_type(v)}")
 
 
