@@ -84,11 +84,15 @@ def _sig(text: str) -> list[Param]:
     params = []
     for part in filter(None, (p.strip() for p in text.split(","))):
         optional = part.startswith("\\")
-        words = part.lstrip("\\").split()
-        mode = "IN"
-        if words[0] in ("INOUT", "VAR", "PERS"):
-            mode, words = words[0], words[1:]
-        params.append(Param(None, words[1], words[0], mode, optional))  # type: ignore[arg-type]
+        alts = []
+        for alt in part.lstrip("\\").split("|"):
+            words = alt.split()
+            mode = "IN"
+            if words[0] in ("INOUT", "VAR", "PERS"):
+                mode, words = words[0], words[1:]
+            alts.append(Param(None, words[1], words[0], mode, optional))  # type: ignore[arg-type]
+        alts[0].alternatives = alts[1:]
+        params.append(alts[0])
     return params
 
 
@@ -145,6 +149,10 @@ FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, 
     "Tan": ("num Angle", "num"),
     "ATan": ("num Value", "num"),
     "ATan2": ("num Y, num X", "num"),
+    "ASin": ("num Value", "num"),
+    "ACos": ("num Value", "num"),
+    "OrientZYX": ("num ZAngle, num YAngle, num XAngle", "orient"),
+    "EulerZYX": (r"\switch X | switch Y | switch Z, orient Rotation", "num"),
     "NumToStr": (r"num Val, num Dec, \switch Exp", "string"),
     "ValToStr": ("any Val", "string"),
     "StrLen": ("string Str", "num"),
@@ -284,6 +292,31 @@ def rel_tool(p: Record, dx: float, dy: float, dz: float, rx: float = 0, ry: floa
             q = qmul(q, rq)
     r["q1"], r["q2"], r["q3"], r["q4"] = (_clean(c) for c in q)
     return out
+
+
+def orient_zyx(z: float, y: float, x: float) -> Record:
+    """The orientation of rotations about z, then the new y, then the new x (degrees)."""
+    q = [1.0, 0.0, 0.0, 0.0]
+    for angle, axis in ((z, 2), (y, 1), (x, 0)):
+        h = math.radians(angle) / 2
+        rq = [math.cos(h), 0.0, 0.0, 0.0]
+        rq[1 + axis] = math.sin(h)
+        q = qmul(q, rq)
+    return Record("orient", dict(zip(("q1", "q2", "q3", "q4"), (_clean(c) for c in q))))
+
+
+def euler_zyx(axis: str, o: Record) -> float:
+    """One angle (degrees) of an orientation's z-y-x Euler decomposition."""
+    w, x, y, z = (o.fields[k] for k in ("q1", "q2", "q3", "q4"))
+    norm = math.sqrt(w * w + x * x + y * y + z * z) or 1.0
+    w, x, y, z = w / norm, x / norm, y / norm, z / norm
+    if axis == "z":
+        a = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    elif axis == "y":
+        a = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    else:
+        a = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    return _clean(math.degrees(a))
 
 
 def dist(a: Record, b: Record) -> float:

@@ -485,7 +485,8 @@ _PROPER = {k.lower(): k for k in (
     "Incr Decr Add SetDO SetAO SetGO Set Reset InvertDO PulseDO WaitTime WaitDI WaitDO WaitUntil WaitRob TPWrite "
     "TPErase MoveJ MoveL MoveC MoveAbsJ Stop Break ConfJ ConfL VelSet AccSet BookErrNo Offs RelTool CRobT "
     "CJointT Present Abs Round Trunc Sqrt Pow Exp Sin Cos Tan ATan ATan2 NumToStr ValToStr StrLen StrPart "
-    "Dist DOutput DInput AOutput GOutput TestDI ClkReset ClkStart ClkStop ClkRead Dim").split()}
+    "Dist DOutput DInput AOutput GOutput TestDI ClkReset ClkStart ClkStop ClkRead Dim ASin ACos OrientZYX "
+    "EulerZYX").split()}
 
 
 def _proper(key: str) -> str:

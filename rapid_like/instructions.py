@@ -90,6 +90,18 @@ class InstructionsMixin:
                 return math.degrees(math.atan(x))
             if key == "atan2":
                 return math.degrees(math.atan2(vals[0], vals[1]))
+            if key in ("asin", "acos"):
+                if not -1 <= x <= 1:
+                    raise self.fail(f"{e.name} of {fmt_num(x)}: the value must be -1 to 1", e.span,
+                                    "ERR_INVALID_VALUE")
+                return _clean(math.degrees(math.asin(x) if key == "asin" else math.acos(x)))
+            if key == "orientzyx":
+                return B.orient_zyx(vals[0], vals[1], vals[2])
+            if key == "eulerzyx":
+                axis = "x" if "x" in bound else "y" if "y" in bound else "z" if "z" in bound else None
+                if axis is None:
+                    raise self.fail("EulerZYX needs one of \\X, \\Y or \\Z", e.span, "ERR_INVALID_VALUE")
+                return B.euler_zyx(axis, arg("rotation"))
             if key == "numtostr":
                 return B.num_to_str(vals[0], vals[1], bool(vals[2]))
             if key == "valtostr":
