@@ -97,7 +97,7 @@ def _sig(text: str) -> list[Param]:
 
 
 _MOVE_OPTS = r"\num V, \num T, \num Z, \switch Conc, \wobjdata WObj"
-INSTRUCTIONS: dict[str, list[Param]] = {k.lower(): _sig(v) for k, v in {
+_INSTRUCTIONS = {
     "Incr": "INOUT num Name",
     "Decr": "INOUT num Name",
     "Add": "INOUT num Name, num AddValue",
@@ -130,9 +130,10 @@ INSTRUCTIONS: dict[str, list[Param]] = {k.lower(): _sig(v) for k, v in {
     "ClkReset": "INOUT clock Clock",
     "ClkStart": "INOUT clock Clock",
     "ClkStop": "INOUT clock Clock",
-}.items()}
+}
+INSTRUCTIONS: dict[str, list[Param]] = {k.lower(): _sig(v) for k, v in _INSTRUCTIONS.items()}
 
-FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, (s, r) in {
+_FUNCTIONS = {
     "Offs": ("robtarget Point, num XOffset, num YOffset, num ZOffset", "robtarget"),
     "RelTool": (r"robtarget Point, num Dx, num Dy, num Dz, \num Rx, \num Ry, \num Rz", "robtarget"),
     "CRobT": (r"\tooldata Tool, \wobjdata WObj", "robtarget"),
@@ -165,7 +166,9 @@ FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, 
     "AOutput": ("signalao Signal", "num"),
     "GOutput": ("signalgo Signal", "num"),
     "TestDI": ("signaldi Signal", "bool"),
-}.items()}
+}
+FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, (s, r) in _FUNCTIONS.items()}
+PROPER_NAMES = {k.lower(): k for k in (*_INSTRUCTIONS, *_FUNCTIONS)}  # for messages: `Abs`, not `abs`
 
 # Functions the evaluator implements itself (they need the host, the frame or the program).
 SPECIAL_FUNCTIONS = {"crobt", "cjointt", "present", "doutput", "dinput", "aoutput", "goutput", "testdi"}

@@ -16,9 +16,8 @@ from . import builtins as B
 from . import nodes as n
 from .errors import CheckError, Span
 from .host import SignalInfo
-from .values import ATOMIC, KNOWN_TYPES, NUMERIC, RECORDS, SIGNAL_TYPES, array_type, base_type, split_array_type
+from .values import KNOWN_TYPES, RECORDS, SIGNAL_TYPES, array_type, base_type, split_array_type
 
-ANY = None  # unknown type: do not complain
 
 
 @dataclass
@@ -481,16 +480,5 @@ class Checker:
         raise self.err(f"unknown function '{e.name}'{hint}", e.span)
 
 
-_PROPER = {k.lower(): k for k in (
-    "Incr Decr Add SetDO SetAO SetGO Set Reset InvertDO PulseDO WaitTime WaitDI WaitDO WaitUntil WaitRob TPWrite "
-    "TPErase MoveJ MoveL MoveC MoveAbsJ Stop Break ConfJ ConfL VelSet AccSet BookErrNo Offs RelTool CRobT "
-    "CJointT Present Abs Round Trunc Sqrt Pow Exp Sin Cos Tan ATan ATan2 NumToStr ValToStr StrLen StrPart "
-    "Dist DOutput DInput AOutput GOutput TestDI ClkReset ClkStart ClkStop ClkRead Dim ASin ACos OrientZYX "
-    "EulerZYX").split()}
-
-
 def _proper(key: str) -> str:
-    return _PROPER.get(key, key)
-
-
-__all__ = ["check", "Checker", "ATOMIC", "NUMERIC"]
+    return B.PROPER_NAMES.get(key, key)
