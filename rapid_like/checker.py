@@ -19,7 +19,6 @@ from .host import SignalInfo
 from .values import KNOWN_TYPES, RECORDS, SIGNAL_TYPES, array_type, base_type, split_array_type
 
 
-
 @dataclass
 class Sym:
     kind: str  # data, signal, param, loop, switch
@@ -321,8 +320,6 @@ class Checker:
     def compatible(self, want: str, got: str, e: n.Expr, scope: dict[str, Sym]) -> bool:
         want, got = base_type(want), base_type(got)
         if want == got:
-            if want == "aggregate":
-                return True
             return True
         if got == "aggregate" and split_array_type(want):
             assert isinstance(e, n.Aggregate)
