@@ -138,14 +138,26 @@ class Checker:
                 else:
                     scope[q.key] = Sym(kind, q.type, "CONST" if kind == "switch" else "VAR", name=q.name)
         self.current = r
+        self.labels: list[dict[str, n.Label]] = []
+        self.all_labels = {lab.name.lower() for lab in _walk_labels(r.body)}
+        seen: dict[str, n.Label] = {}
+        for lab in _walk_labels(r.body + (r.error_handler or [])):
+            if lab.name.lower() in seen:
+                raise self.err(f"label {lab.name} is declared twice in {r.name}", lab.span)
+            seen[lab.name.lower()] = lab
         self.block(r.body, scope, in_handler=False)
         if r.error_handler is not None:
             self.block(r.error_handler, scope, in_handler=True)
 
     # ---- statements ----------------------------------------------------------------------------
     def block(self, stmts: list[n.Stmt], scope: dict[str, Sym], in_handler: bool) -> None:
-        for s in stmts:
-            self.stmt(s, scope, in_handler)
+        labels = {s.name.lower(): s for s in stmts if isinstance(s, n.Label)}
+        self.labels.append(labels)
+        try:
+            for s in stmts:
+                self.stmt(s, scope, in_handler)
+        finally:
+            self.labels.pop()
 
     def stmt(self, s: n.Stmt, scope: dict[str, Sym], h: bool) -> None:
         if isinstance(s, n.LocalDecl):
@@ -207,7 +219,13 @@ class Checker:
                 raise self.err("RAISE without an error number is only allowed in an ERROR handler", s.span)
             if s.errno is not None:
                 self.expect_type(s.errno, "errnum", scope)
-        elif isinstance(s, n.Exit):
+        elif isinstance(s, n.Goto):
+            if not any(s.label.lower() in level for level in self.labels):
+                inside = s.label.lower() in self.all_labels
+                raise self.err(f"GOTO {s.label}: " + ("the label is inside another IF, WHILE, FOR or TEST; GOTO "
+                                                      "cannot jump into one" if inside else
+                                                      f"no label {s.label}: in {self.current.name}"), s.label_span)
+        elif isinstance(s, (n.Exit, n.Label)):
             pass
         else:  # pragma: no cover - the parser makes no other statements
             raise self.err(f"unknown statement {type(s).__name__}", s.span)
@@ -475,6 +493,22 @@ class Checker:
         if close:
             hint = f" (did you mean {self.routines[close[0]].name if close[0] in self.routines else _proper(close[0])}?)"
         raise self.err(f"unknown function '{e.name}'{hint}", e.span)
+
+
+def _walk_labels(stmts: list[n.Stmt]):
+    for s in stmts:
+        if isinstance(s, n.Label):
+            yield s
+        elif isinstance(s, n.If):
+            for _, body in s.branches:
+                yield from _walk_labels(body)
+            yield from _walk_labels(s.orelse or [])
+        elif isinstance(s, (n.While, n.For)):
+            yield from _walk_labels(s.body)
+        elif isinstance(s, n.Test):
+            for _, body in s.cases:
+                yield from _walk_labels(body)
+            yield from _walk_labels(s.default or [])
 
 
 def _proper(key: str) -> str:

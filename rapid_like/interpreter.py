@@ -23,8 +23,8 @@ from . import nodes as n
 from .errors import ExecError, Span
 from .host import Host, SignalInfo
 from .instructions import InstructionsMixin
-from .runtime import (ABSENT, NS, Cell, ExitSignal, Fatal, Frame, Propagate, Ref, RetrySignal, ReturnSignal,
-                      TryNextSignal, Wait, component_type, to_ns)
+from .runtime import (ABSENT, NS, Cell, ExitSignal, Fatal, Frame, GotoSignal, Propagate, Ref, RetrySignal,
+                      ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
 from .values import (SIGNAL_KINDS, SIGNAL_TYPES, Aggregate, Array, Record, SignalRef, TypeMismatch, array_type,
                      coerce, default_value, describe_type, fmt_num, json_num, new_array, pos, xyz)
 
@@ -172,8 +172,22 @@ class Interpreter(InstructionsMixin):
 
     # ---- statements -----------------------------------------------------------------------------
     def block(self, stmts: list[n.Stmt], f: Frame):
-        for s in stmts:
-            yield from self.guarded(s, f)
+        i = 0
+        mark = self.suspensions
+        while i < len(stmts):
+            try:
+                yield from self.guarded(stmts[i], f)
+            except GotoSignal as g:
+                target = next((k for k, s in enumerate(stmts) if isinstance(s, n.Label) and s.name.lower() == g.label),
+                              None)
+                if target is None:
+                    raise
+                if target <= i and self.suspensions == mark:  # a backward jump is a loop: one step per turn
+                    yield Wait("step", what=f"GOTO {g.label}")
+                mark = self.suspensions
+                i = target + 1
+                continue
+            i += 1
 
     def guarded(self, s: n.Stmt, f: Frame):
         quick_retries = 0
@@ -261,6 +275,8 @@ class Interpreter(InstructionsMixin):
             raise ReturnSignal(value)
         elif isinstance(s, n.Exit):
             raise ExitSignal()
+        elif isinstance(s, n.Goto):
+            raise GotoSignal(s.label.lower())
         elif isinstance(s, n.Retry):
             raise RetrySignal()
         elif isinstance(s, n.TryNext):

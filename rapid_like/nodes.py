@@ -184,6 +184,19 @@ class Raise(Stmt):
 
 
 @dataclass
+class Goto(Stmt):
+    label: str
+    label_span: Span
+
+
+@dataclass
+class Label(Stmt):
+    """`name:` marks a place GOTO can jump to (in the same block or a block around the GOTO)."""
+
+    name: str
+
+
+@dataclass
 class LocalDecl(Stmt):
     """A data declaration inside a routine; it is (re)initialised each time execution reaches it."""
 

@@ -279,7 +279,10 @@ class Parser:
             if w in ("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE"):
                 return self.keyword_instruction()
             if w == "GOTO":
-                raise self.error("GOTO is not supported by this interpreter")
+                self.advance()
+                label = self.expect_ident("a label after GOTO")
+                self.end_of_instruction()
+                return n.Goto(t.span, label.text, label.span)
         raise self.error(f"expected an instruction, found {self.found()}")
 
     def keyword_instruction(self) -> n.Stmt:
@@ -298,6 +301,10 @@ class Parser:
 
     def simple_ident_statement(self) -> n.Stmt:
         start = self.tok
+        if self.peek().is_op(":"):  # a label: `next:`
+            self.advance()
+            self.advance()
+            return n.Label(start.span, start.text)
         if self.peek().is_op(":=", ".", "{"):
             target = self.postfix(self.name_expr())
             if not self.tok.is_op(":="):
@@ -365,7 +372,7 @@ class Parser:
         cond = self.expression()
         if not self.tok.is_kw("THEN"):
             # compact IF: IF cond instruction;
-            if self.tok.kind is Kind.IDENT or self.tok.is_kw("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE"):
+            if self.tok.kind is Kind.IDENT or self.tok.is_kw("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE", "GOTO"):
                 body = [self.statement()]
                 return n.If(kw.span, [(cond, body)], None, compact=True)
             raise self.error(f"expected THEN after the IF condition, found {self.found()}")

@@ -44,6 +44,13 @@ class ExitSignal(Exception):
     """EXIT: the program ends."""
 
 
+class GotoSignal(Exception):
+    """GOTO: caught by the innermost block around it that holds the label."""
+
+    def __init__(self, label: str):
+        self.label = label
+
+
 class RetrySignal(Exception):
     pass
 
