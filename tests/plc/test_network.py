@@ -93,6 +93,14 @@ def test_plc_watch_prints_one_line_per_sample_when_not_a_terminal(server):
     assert all(len(line.split()) == 3 for line in lines[1:])
 
 
+def test_plc_map_lists_the_names_with_table_address_unit_and_range(server):
+    r = plc(server, "map")
+    assert r.returncode == 0, r.stderr
+    rows = {line.split()[0]: line.split() for line in r.stdout.splitlines()[2:]}
+    assert rows["L2"] == ["L2", "holding_register", "16", "uint16", "mm", "0..441", "rw"]
+    assert rows["L2.force"][1:] == ["input_register", "21-22", "uint32", "N", "0..", "r"]
+
+
 def test_plc_unknown_name_is_exit_2_with_a_suggestion(server):
     r = plc(server, "read", "L2.actul")
     assert r.returncode == 2 and r.stdout == ""
@@ -130,6 +138,22 @@ def grip_over_the_network(station):
         image = plc_.run_until(lambda i, s: s.phase in (Phase.HELD, Phase.FAULT_MISSED), timeout=10.0)
         plc_.run(seconds=0.2)
         return plc_, dict(image), c.read("doGripped", "GrippedPart", "L2.actual", "L3.actual", "L4.actual", "sim.step")
+
+
+def test_a_grip_and_release_across_the_network_frees_the_ring():
+    seq = ring_sequence()
+    with twin_server(BENCH, lockstep=True) as srv, srv.client() as c:
+        io = srv.io(c, local=seq.handshake_signals())
+        plc_ = ScanCycle(io, seq)
+        io.set("grip_request", True)
+        plc_.run_until(lambda i, s: s.phase is Phase.HELD, timeout=10.0)
+        assert c.get("doGripped") and io.get("gripped")
+        io.set("grip_request", False)
+        io.set("release_request", True)
+        image = plc_.run_until(lambda i, s: s.phase in (Phase.IDLE, Phase.FAULT_STUCK), timeout=10.0)
+        assert plc_.state.phase is Phase.IDLE and not io.get("gripped") and not c.get("doGripped")
+        assert not any(image[n] for n in ("L2.contact", "L3.contact", "L5.contact"))
+        assert image["L2.actual"] >= 329.5  # back where the next outside grip starts
 
 
 def test_a_grip_across_the_network_in_lockstep_is_the_same_on_every_run():
