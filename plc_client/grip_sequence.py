@@ -8,7 +8,9 @@ margin further. It grips from outside (closing) and from inside (opening), with 
 
     IDLE --grip request--> GRIPPING --all forces >= threshold--> HELD --release request--> RELEASING --> IDLE
                                     --end of travel, no force--> FAULT_MISSED
+                                                    RELEASING --limit reached, part still touching--> FAULT_STUCK
     (optional) IDLE/FAULT --prepare request--> PREPARING --in position--> IDLE
+    A new request clears a fault (a release from a fault opens the fingers for the next attempt).
 
 Positions, speed and forces are in the units of the I/O it runs against: over the network, the register
 map's engineering units (mm, N); in process, `TwinIO` publishes the same units. Handshake signals are
@@ -246,7 +248,7 @@ class GripSequence:
             state.phase, state.held_at = Phase.HELD, dict(state.setpoint)
             state.forces_at_grip = dict(zip(self.forces, forces))
             return
-        direction, end = self.close_direction[state.mode], float(self.end_of_travel[state.mode])
+        end = float(self.end_of_travel[state.mode])
         step = self.speed * elapsed
         if self.per_finger:
             moving = [a for a, f in zip(self.axes, forces) if f < self.threshold]

@@ -101,6 +101,22 @@ def test_plc_map_lists_the_names_with_table_address_unit_and_range(server):
     assert rows["L2.force"][1:] == ["input_register", "21-22", "uint32", "N", "0..", "r"]
 
 
+def test_plc_run_scans_user_logic_against_the_server_in_lockstep(server, client, tmp_path):
+    (tmp_path / "logic.py").write_text(
+        "from plc_client import plc_logic\n\n\n"
+        "@plc_logic(inputs=['L4.actual'])\n"
+        "def to_328(inputs, state):\n"
+        "    return {'L4': 328.0, 'Active': inputs['L4.actual'] > 328.5}\n")
+    step = client.get("sim.step")
+    r = plc(server, "run", f"{tmp_path / 'logic.py'}:to_328", "--scans", "120")  # 1.2 s of PLC time
+    assert r.returncode == 0, r.stderr
+    assert "lockstep" in r.stderr and "Active=0" in r.stdout  # the bool outputs' changes are logged
+    assert client.get("sim.step") - step == 100  # 120 scans of 10 ms = 100 steps of 12 ms
+    assert client.get("L4.actual") == pytest.approx(328.0, abs=0.1)
+    client.write(L4=330.0, Active=True)
+    client.advance(100)
+
+
 def test_plc_unknown_name_is_exit_2_with_a_suggestion(server):
     r = plc(server, "read", "L2.actul")
     assert r.returncode == 2 and r.stdout == ""
