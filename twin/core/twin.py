@@ -221,6 +221,71 @@ class Twin:
                 out[f"robot.j{i}"] = float(q)
         self._outputs = out
 
+    # -- robot motion -----------------------------------------------------------------------------
+    def target(self, name: str):
+        """A named robot target of the station, as a TCP Pose in the world frame."""
+        from .geometry import Pose
+
+        placement = self.station.robot_targets.get(name)
+        if placement is None:
+            known = ", ".join(self.station.robot_targets) or "none"
+            raise MotionError(name, f"no such robot target in station {self.station.name!r} (targets: {known})")
+        return Pose.from_xyz_rpy(placement.xyz, placement.rpy)
+
+    def move(self, instr: str, target, speed: float = 1.0, *, v_ori: float | None = None, via=None,
+             name: str | None = None) -> None:
+        """Start a motion from where the robot is now; it runs over the next steps (see `robot_busy`).
+
+        `instr` is MoveJ, MoveL, MoveC (through `via`) or MoveAbsJ (target: joint angles in rad). A
+        target is a Pose or the name of a station target; `speed` is the TCP speed in m/s, `v_ori` the
+        reorientation speed in rad/s. The whole path is checked before the robot moves: a target it
+        cannot reach raises MotionError naming the target.
+        """
+        from . import motion
+
+        if self.robot is None:
+            raise MotionError(name or str(target), f"station {self.station.name!r} has no robot")
+        if isinstance(target, str):
+            name = name or target
+            target = self.target(target)
+        if isinstance(via, str):
+            via = self.target(via)
+        name = name or instr
+        speed_spec = motion.Speed(v_tcp=speed, v_ori=v_ori) if v_ori is not None else motion.Speed(v_tcp=speed)
+        q0 = self.robot.q
+        if instr == "MoveJ":
+            traj = motion.movej(self.kinematics, q0, target, None, speed_spec, name)
+        elif instr == "MoveL":
+            traj = motion.movel(self.kinematics, q0, target, speed_spec, name)
+        elif instr == "MoveC":
+            traj = motion.movec(self.kinematics, q0, via, target, speed_spec, name)
+        elif instr == "MoveAbsJ":
+            traj = motion.moveabsj(q0, target, speed_spec, self.kinematics.limits, name)
+        else:
+            raise MotionError(name, f"unknown motion instruction {instr!r}")
+        self.robot.start(traj, self.time)
+        self._publish()
+
+    @property
+    def robot_busy(self) -> bool:
+        return self.robot is not None and self.robot.busy(self.time)
+
+    @property
+    def robot_q(self):
+        return self.robot.q
+
+    def tcp_pose(self):
+        return self.robot.tcp_pose()
+
+    def run_motion(self, instr: str, target, speed: float = 1.0, *, max_time: float = 120.0, **kw) -> None:
+        """Start a motion and step until the robot is in position."""
+        self.move(instr, target, speed, **kw)
+        limit = self.step_count + round(max_time / self.dt)
+        while self.robot_busy:
+            if self.step_count >= limit:
+                raise MotionError(str(kw.get("name") or target), f"still moving after {max_time:g} s")
+            self.step()
+
     # -- physical state -----------------------------------------------------------------------------
     @property
     def gripped_part(self) -> str:
