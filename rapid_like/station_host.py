@@ -161,12 +161,39 @@ class ControllerDevice:
         pass
 
 
-def attach_controller(twin, on_event: Callable[[dict], None] | None = None, autostart: bool = True) -> Controller:
-    """Load the station's RAPID program and make it the twin's robot controller."""
+def check_wiring(twin, spec: ControllerSpec) -> None:
+    """Every `drives` names an input of the twin and every `source` an output, before anything runs."""
+    from twin.core.errors import StationError
+    from twin.core.signals import INPUT as TWIN_INPUT
+
+    file = str(twin.station.file)
+    known = {s.name: s for s in twin.signals}
+    for i, sig in enumerate(spec.io):
+        for key, want in (("drives", TWIN_INPUT), ("source", None)):
+            target = getattr(sig, key)
+            if not target:
+                continue
+            found = known.get(target)
+            if found is None:
+                names = [s.name for s in twin.signals if (s.direction == TWIN_INPUT) == (want == TWIN_INPUT)]
+                raise StationError(file, f"controller.io[{i}].{key}",
+                                   f"{sig.name}: the twin has no signal {target!r} (it has: {', '.join(names)})")
+            if want == TWIN_INPUT and found.direction != TWIN_INPUT:
+                raise StationError(file, f"controller.io[{i}].{key}",
+                                   f"{sig.name}: {target!r} is an output of the twin; an output can only be a `source`")
+
+
+def attach_controller(twin, on_event: Callable[[dict], None] | None = None, autostart: bool = True,
+                      entry: str | None = None) -> Controller:
+    """Load the station's RAPID program and make it the twin's robot controller.
+
+    `entry` overrides the station's entry routine (e.g. `Path_FullAutoRun` for one cycle)."""
     spec = twin.station.controller
     if spec is None:
         raise TwinError(f"station {twin.station.name!r} has no [controller]")
+    check_wiring(twin, spec)
     host = TwinHost(twin, spec)
-    controller = Controller(load_program(spec.program), host, entry=spec.entry, on_event=on_event, autostart=autostart)
+    controller = Controller(load_program(spec.program), host, entry=entry or spec.entry, on_event=on_event,
+                            autostart=autostart)
     twin.add_device(ControllerDevice(host, controller))
     return controller

@@ -11,13 +11,22 @@ from typing import Callable
 from .core import Twin
 
 
-def open_cell(station: str | Path, on_event: Callable[[dict], None] | None = None) -> Twin:
-    """Load a station; if it has a `[controller]`, its RAPID program runs as the robot controller."""
+def open_cell(station: str | Path, on_event: Callable[[dict], None] | None = None, *,
+              entry: str | None = None) -> Twin:
+    """Load a station; if it has a `[controller]`, its RAPID program runs as the robot controller.
+
+    `on_event` receives the controller's events (TPWrite lines, output writes, motions, the end or a
+    runtime error; see `rapid_like.controller`); `entry` overrides the station's entry routine.
+    A program that does not parse or check raises a `rapid_like` error naming file:line:column.
+    """
     twin = Twin.from_station(station)
+    twin.controller = None
     if twin.station.controller is not None:
         from rapid_like.station_host import attach_controller
 
-        twin.controller = attach_controller(twin, on_event=on_event)
-    else:
-        twin.controller = None
+        try:
+            twin.controller = attach_controller(twin, on_event=on_event, entry=entry)
+        except BaseException:
+            twin.close()
+            raise
     return twin

@@ -78,6 +78,13 @@ def main(argv: list[str] | None = None) -> int:
     except TwinError as exc:
         print(f"twin: error: {exc}", file=sys.stderr)
         return 2
+    except Exception as exc:
+        from rapid_like.errors import RapidError
+
+        if not isinstance(exc, RapidError):
+            raise
+        print(f"twin: {exc.headline()}", file=sys.stderr)  # the station's RAPID program: FILE:LINE:COL
+        return 2
     except KeyboardInterrupt:
         return 130
 

@@ -14,7 +14,11 @@ MODULE RingRig
   ! I/O (configured in the controller, not declared here):
   !   DO movePickOutside, movePlaceOutside, movePickInside, movePlaceInside, fullAutoRun
   !   DI diGripped
-  !   AO aoAxis1, aoAxis2, aoAxis3   finger positions in mm (0 to 441)
+  !   AO aoAxis1, aoAxis2, aoAxis3   finger setpoints in mm (0 to 441)
+  !   AI aiAxis1, aiAxis2, aiAxis3   actual finger positions in mm
+  !
+  ! The fingers move at a limited speed (100 mm/s), not in one jump as in RobotStudio: a procedure
+  ! that moves them far waits until they are there (aiAxis) before the robot goes down.
   !
   ! Outside grip: the fingers' inner faces are at radius = setpoint; 330 clears the
   ! ring (outer radius 320) and DecrementJointValueOutside closes until diGripped.
@@ -77,7 +81,8 @@ MODULE RingRig
     MoveJ Target_AppPlaceOutside,vmax,fine,tcpGripper\WObj:=wobj0;
     MoveL Target_PlaceOutside,v1000,fine,tcpGripper\WObj:=wobj0;
     IncrementJointValueOutside;
-    MoveJ Target_AppPlaceOutside,vmax,fine,tcpGripper\WObj:=wobj0;
+    ! Straight up: the released fingers are 1 mm from the ring.
+    MoveL Target_AppPlaceOutside,v1000,fine,tcpGripper\WObj:=wobj0;
   ENDPROC
 
   PROC Path_PickInside()
@@ -86,6 +91,7 @@ MODULE RingRig
     SetAO aoAxis1,150;
     SetAO aoAxis2,150;
     SetAO aoAxis3,150;
+    WaitUntil aiAxis1<151 AND aiAxis2<151 AND aiAxis3<151;
     MoveL Target_PickInside,v1000,fine,tcpGripper\WObj:=wobj0;
     IncrementJointValueInside;
     MoveJ Target_AppPickInside,vmax,fine,tcpGripper\WObj:=wobj0;
@@ -96,7 +102,13 @@ MODULE RingRig
     MoveJ Target_AppPlaceInside,vmax,fine,tcpGripper\WObj:=wobj0;
     MoveL Target_PlaceInside,v1000,fine,tcpGripper\WObj:=wobj0;
     DecrementJointValueInside;
-    MoveJ Target_AppPlaceInside,vmax,fine,tcpGripper\WObj:=wobj0;
+    ! Straight up: the released fingers are 1 mm from the ring.
+    MoveL Target_AppPlaceInside,v1000,fine,tcpGripper\WObj:=wobj0;
+    ! Open the fingers for the next pick from outside.
+    SetAO aoAxis1,330;
+    SetAO aoAxis2,330;
+    SetAO aoAxis3,330;
+    WaitUntil aiAxis1>329 AND aiAxis2>329 AND aiAxis3>329;
   ENDPROC
 
   PROC Path_FullAutoRun()

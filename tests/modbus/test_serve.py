@@ -252,7 +252,7 @@ def test_the_ring_rig_serves_its_robot_axes_in_hundredths_of_a_degree():
         e = rmap["robot.j1"]
         words = ok(c.read_input_registers(e.address, count=12, device_id=UNIT)).registers
         axes = [rmap[f"robot.j{i}"].decode(words[2 * i - 2:2 * i]) for i in range(1, 7)]
-        assert axes == pytest.approx([0.0, 0.0, 0.0, 0.0, 90.0, 0.0], abs=0.02)  # home_deg
+        assert axes == pytest.approx([0.0, -20.96, 42.09, 0.0, 68.87, -180.0], abs=0.05)  # home_deg, at Target_Home
         assert not ok(c.read_discrete_inputs(rmap["robot.busy"].address, count=1, device_id=UNIT)).bits[0]
         assert rmap["L2.actual"].decode(ok(c.read_input_registers(rmap["L2.actual"].address, count=1,
                                                                   device_id=UNIT)).registers) == pytest.approx(350, abs=1)

@@ -12,7 +12,11 @@ from rapid_like.offline import SignalChange, run_offline
 RIG = Path(__file__).resolve().parents[2] / "stations" / "ring_rig" / "ring_rig.mod"
 SIGNALS = [SignalInfo(n, "DO") for n in ("movePickOutside", "movePlaceOutside", "movePickInside",
                                            "movePlaceInside", "fullAutoRun")] + \
-          [SignalInfo("diGripped", "DI")] + [SignalInfo(f"aoAxis{i}", "AO") for i in (1, 2, 3)]
+          [SignalInfo("diGripped", "DI")] + [SignalInfo(f"aoAxis{i}", "AO") for i in (1, 2, 3)] + \
+          [SignalInfo(f"aiAxis{i}", "AI") for i in (1, 2, 3)]
+# Offline the actual finger positions (AI) do not follow the setpoints: the fingers are "in the bore"
+# (100 mm) from the start, and "open at 400 mm" at 4.0 s, when the cycle's last release is done.
+FINGERS_ARRIVE = [SignalChange(f"aiAxis{i}", v, t) for t, v in ((0.0, 100), (4.0, 400)) for i in (1, 2, 3)]
 
 # The thesis's Figures 21 to 23, as printed.
 THESIS = {
@@ -62,6 +66,7 @@ def full_cycle(grip_times):
     for t in grip_times:
         changes.append(SignalChange("diGripped", value, t))
         value = 1 - value
+    changes += FINGERS_ARRIVE
     module = parse(RIG.read_text(), str(RIG))
     return run_offline(module, SIGNALS, changes, entry="Path_FullAutoRun", max_time=60)
 
@@ -95,7 +100,9 @@ def test_fingers_close_then_open_then_grip_the_bore_then_release():
     assert inside == [150, 151, 152, 153, 154, 155]
     # release on the right pallet: close while gripped (3.0 .. 3.8)
     assert [v for t, v in ax1 if 3.0 <= t < 4.0] == [154, 153, 152, 151, 150]
-    assert out.host.values["aoAxis1"] == out.host.values["aoAxis2"] == out.host.values["aoAxis3"] == 150
+    # then open to 330 for the next pick from outside
+    assert [v for t, v in ax1 if t >= 4.0] == [330]
+    assert out.host.values["aoAxis1"] == out.host.values["aoAxis2"] == out.host.values["aoAxis3"] == 330
 
 
 def test_init_idles_in_main_and_starts_a_path_on_its_signal():
@@ -114,7 +121,9 @@ def test_rig_program_runs_with_the_cli(capsys):
     from rapid_like.cli import main
     io = ",".join(f"{s.kind}:{s.name}" for s in SIGNALS)
     code = main(["run", str(RIG), "--entry", "Path_FullAutoRun", "--io", io, "--set", "diGripped=1@1",
-                 "--set", "diGripped=0@2", "--set", "diGripped=1@3", "--set", "diGripped=0@4", "--trace"])
+                 "--set", "diGripped=0@2", "--set", "diGripped=1@3", "--set", "diGripped=0@4",
+                 "--set", "aiAxis1=100", "aiAxis2=100", "aiAxis3=100", "--set", "aiAxis1=400@4", "aiAxis2=400@4", "aiAxis3=400@4",
+                 "--trace"])
     out = capsys.readouterr().out.splitlines()
     assert code == 0
     assert out[-1] == '{"t": 4.0, "type": "end", "reason": "completed"}'

@@ -15,11 +15,25 @@ import sys
 from pathlib import Path
 
 
-def open_twin(station):
-    """The twin `serve` runs for a station (the same one `map` describes, so both agree)."""
-    from twin.core import Twin
+def open_twin(station, on_event=None):
+    """The cell `serve` runs for a station (the same one `map` describes, so both agree): the twin and,
+    when the station has a `[controller]`, its RAPID program as the robot controller."""
+    from twin.cell import open_cell
 
-    return Twin.from_station(Path(station))
+    return open_cell(Path(station), on_event=on_event)
+
+
+def controller_log(event: dict) -> None:
+    """What the robot controller says, in the server's log: TPWrite lines, a runtime error, the end."""
+    from .bridge import _log
+
+    kind, t = event.get("type"), event.get("t", 0.0)
+    if kind == "print":
+        _log(f"[t={t:.3f} s] robot: {event['text']}")
+    elif kind == "error":
+        _log(f"[t={t:.3f} s] robot program error at line {event['line']}: {event['message']}")
+    elif kind == "end":
+        _log(f"[t={t:.3f} s] robot program ended ({event['reason']})")
 
 
 def _positive(text: str) -> float:
@@ -72,7 +86,7 @@ def cmd_map(args) -> int:
 def cmd_serve(args) -> int:
     from .register_map import build_register_map
 
-    twin = open_twin(args.station)
+    twin = open_twin(args.station, on_event=controller_log)
     try:
         rmap = build_register_map(twin.signals, twin.station.name)
         return asyncio.run(serve(twin, rmap, host=args.host, port=args.port, unit_id=args.unit_id,

@@ -1,0 +1,90 @@
+"""The rig's RAPID program bound to the ring rig station: it is the robot controller of the physics cell.
+
+The station's `[controller]` wires aoAxis1..3 (mm) to the finger inputs L2..L4 (m), diGripped to the
+gripper's doGripped and aiAxis1..3 to the actual finger positions; motions drive the arm.
+"""
+from __future__ import annotations
+
+import math
+import shutil
+
+import pytest
+
+from tests.conftest import STATIONS
+from twin.cell import open_cell
+from twin.core.errors import StationError
+
+RIG = STATIONS / "ring_rig"
+RIGHT, LEFT = (1.6, -0.8), (1.6, 0.8)
+
+
+def run_until(twin, done, limit_s: float) -> None:
+    end = twin.step_count + round(limit_s / twin.dt)
+    while not done():
+        assert twin.step_count < end, f"not done after {limit_s} s of simulated time"
+        twin.step()
+
+
+def test_the_program_carries_the_ring_right_to_left_and_back_in_physics():
+    events = []
+    with open_cell(RIG, on_event=events.append, entry="Path_FullAutoRun") as twin:
+        ctl = twin.controller
+        grips = []  # (t, gripped, ring xy) at every change of doGripped
+        last = False
+
+        def watch():
+            nonlocal last
+            if twin.read("doGripped") != last:
+                last = twin.read("doGripped")
+                grips.append((round(twin.time, 3), last, twin.object_pose("ring")[0][:2]))
+            return ctl.state == "completed"
+
+        run_until(twin, watch, 60.0)
+        assert [e for e in events if e["type"] in ("error", "end")] == [
+            {"t": pytest.approx(twin.time - twin.dt, abs=0.013), "type": "end", "reason": "completed"}]
+        # gripped on the right, released on the left, gripped on the left, released on the right
+        assert [g for _, g, _ in grips] == [True, False, True, False]
+        where = [xy for _, _, xy in grips]
+        for xy, pallet in zip(where, (RIGHT, LEFT, LEFT, RIGHT)):
+            assert xy == pytest.approx(pallet, abs=0.003)
+        # the outside grip closed from 330 mm onto the ring's 320 mm radius; the inside one opened to 200
+        ao1 = [(e["t"], e["value"]) for e in events if e.get("signal") == "aoAxis1"]
+        assert [v for t, v in ao1 if t <= grips[0][0]][-1] == 320
+        assert [v for t, v in ao1 if grips[1][0] < t <= grips[2][0]][-1] == 200
+        (x, y, z), q = twin.object_pose("ring")
+        assert math.dist((x, y, z), (*RIGHT, 0.18)) < 0.005  # back where it started, lying flat
+        assert abs(q[0]) < 0.01 and abs(q[1]) < 0.01
+        assert twin.read("L2.actual") == pytest.approx(0.330, abs=0.001)  # open for the next pick
+
+
+def test_init_waits_for_a_path_signal_like_the_io_simulator():
+    with open_cell(RIG) as twin:
+        twin.step(50)
+        assert not twin.read("robot.busy") and twin.read("L2") == pytest.approx(0.35)  # idle in Main
+        twin.write("movePickOutside", True)
+        run_until(twin, lambda: twin.read("doGripped"), 10.0)
+        assert not twin.read("movePickOutside")  # Path_PickOutside resets its signal
+        assert twin.read("aoAxis1") == 320 and twin.read("L2") == pytest.approx(0.320)
+        run_until(twin, lambda: twin.object_pose("ring")[0][2] > 0.5, 5.0)  # lifted to the approach
+        assert twin.read("diGripped") and twin.read("GrippedPart") == "ring"
+
+
+def copy_rig(tmp_path):
+    shutil.copytree(STATIONS / "robots", tmp_path / "robots")
+    return shutil.copytree(RIG, tmp_path / "rig")
+
+
+def test_wiring_to_a_signal_the_twin_lacks_names_the_file_and_key(tmp_path):
+    station = copy_rig(tmp_path)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace('drives = "L3"', 'drives = "L9"'))
+    with pytest.raises(StationError, match=r"station\.toml: controller\.io\[7\]\.drives: aoAxis2: the twin has no signal 'L9'"):
+        open_cell(station)
+
+
+def test_an_output_of_the_twin_cannot_be_driven(tmp_path):
+    station = copy_rig(tmp_path)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace('drives = "L3"', 'drives = "doGripped"'))
+    with pytest.raises(StationError, match=r"controller\.io\[7\]\.drives: aoAxis2: 'doGripped' is an output"):
+        open_cell(station)
