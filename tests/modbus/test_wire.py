@@ -3,7 +3,8 @@
 Every case here is one a bare pymodbus 3.16 server gets wrong or that the issue spells out.
 Addresses are the ring bench's (see `twin map tests/plc/stations/ring_bench`): holding registers
 `sim.advance` at 0, `L2`..`L5` at 16..19 (0.01 mm, 0..44100 counts); input registers `sim.step` at 0,
-`GrippedPart` at 16, `L2.actual` at 17; coil `Active` at 16; discrete input `doGripped` at 16.
+`GrippedPart` at 16, `L2.actual` at 17; coils `Active` at 16 and `ring.present` at 17; discrete input
+`doGripped` at 16.
 """
 from __future__ import annotations
 
@@ -54,7 +55,7 @@ def test_a_read_of_zero_or_more_than_the_limit_gets_illegal_data_value(raw, fc, 
     (3, 19, 2),      # crosses the end of the map
     (3, 1, 1),       # a gap in the reserved block
     (3, 0, 17),      # from sim.advance through the gap into L2
-    (4, 9, 1), (4, 60000, 10), (1, 0, 1), (1, 17, 1), (2, 3, 1), (2, 16, 100),
+    (4, 9, 1), (4, 60000, 10), (1, 0, 1), (1, 18, 1), (2, 3, 1), (2, 16, 100),
 ])
 def test_an_address_outside_the_map_or_in_a_gap_gets_illegal_data_address(raw, fc, address, count):
     assert raw.request(pdu(fc, address, count)) == exception(fc, 0x02)
@@ -62,9 +63,9 @@ def test_an_address_outside_the_map_or_in_a_gap_gets_illegal_data_address(raw, f
 
 def test_writes_outside_the_map_get_illegal_data_address(raw):
     assert raw.request(pdu(6, 20, 100)) == exception(6, 0x02)
-    assert raw.request(pdu(5, 17, 0xFF00)) == exception(5, 0x02)
+    assert raw.request(pdu(5, 18, 0xFF00)) == exception(5, 0x02)
     assert raw.request(bytes([16]) + struct.pack(">HHBHH", 19, 2, 4, 1, 2)) == exception(16, 0x02)
-    assert raw.request(bytes([15]) + struct.pack(">HHB", 16, 2, 1) + b"\x03") == exception(15, 0x02)
+    assert raw.request(bytes([15]) + struct.pack(">HHB", 17, 2, 1) + b"\x03") == exception(15, 0x02)
 
 
 def test_a_value_outside_the_range_gets_illegal_data_value_and_changes_nothing(raw):

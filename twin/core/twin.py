@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+
+import pybullet
 from typing import Protocol
 
 from .errors import MotionError, SignalError
@@ -95,6 +97,8 @@ class Twin:
             self.robot = Robot(self.world.client, self.world.machine,
                                tuple(ROBOT_PREFIX + j for j in st.robot.joints), self.kinematics)
             self.robot.reset([math.radians(a) for a in st.robot.home_deg])
+        self._present = {f"{t.name}.present": True for t in st.targets}  # as written
+        self._placed = dict(self._present)  # as applied to the world
         self._outputs: dict[str, object] = {}
         self._publish()
 
@@ -123,6 +127,7 @@ class Twin:
         for _ in range(n):
             for device in self.devices:
                 device.before_step(self)
+            self._place_targets()
             self.gripper.command()
             if self.robot is not None:
                 self.robot.update(self.time)
@@ -161,6 +166,13 @@ class Twin:
             sig.append(SignalSpec("robot.busy", OUTPUT, BOOL, group="robot", description="the robot is executing a motion"))
             for i, _ in enumerate(st.robot.joints, start=1):
                 sig.append(SignalSpec(f"robot.j{i}", OUTPUT, FLOAT, "rad", group="robot", description=f"robot axis {i} position"))
+        for t in st.targets:
+            sig.append(SignalSpec(f"{t.name}.present", INPUT, BOOL, group="cell",
+                                  description=f"{t.name} is in the cell: write 0 to take it away (a missing part), "
+                                              "1 to put it back where the station places it"))
+            for axis in "xyz":
+                sig.append(SignalSpec(f"{t.name}.{axis}", OUTPUT, FLOAT, "m", group="cell",
+                                      description=f"{axis} of {t.name}'s centre in the world frame"))
         return tuple(sig)
 
     def _joint_unit(self, joint: str) -> str:
@@ -185,7 +197,11 @@ class Twin:
         if device is not None:
             return device.read(name)
         if spec.direction == INPUT:
-            return self.gripper.active if name == "Active" else self.gripper.setpoint[name]
+            if name == "Active":
+                return self.gripper.active
+            if name in self._present:
+                return self._present[name]
+            return self.gripper.setpoint[name]
         return self._outputs[name]
 
     def write(self, name: str, value) -> None:
@@ -196,6 +212,8 @@ class Twin:
         device = self._owner[name]
         if device is not None:
             device.write(name, value)
+        elif name in self._present:
+            self._present[name] = bool(value)
         elif spec.type == BOOL:
             self.gripper.set_active(bool(value))
         else:
@@ -219,6 +237,9 @@ class Twin:
             out["robot.busy"] = self.robot.busy(self.time)
             for i, q in enumerate(self.robot.q, start=1):
                 out[f"robot.j{i}"] = float(q)
+        for t in self.station.targets:
+            (x, y, z), _ = self.world.pose(t.name)
+            out[f"{t.name}.x"], out[f"{t.name}.y"], out[f"{t.name}.z"] = x, y, z
         self._outputs = out
 
     # -- robot motion -----------------------------------------------------------------------------
@@ -307,9 +328,30 @@ class Twin:
         return self.world.pose(name)
 
     def remove_object(self, name: str) -> None:
-        """Take an object out of the world (e.g. a ring that is not there: a missed-grip scenario)."""
-        uid = self.world.body_ids[name]
-        if self.gripper.state.gripped == name:
-            self.gripper._release()
-        self.world.client.resetBasePositionAndOrientation(uid, [0, 0, -100], [0, 0, 0, 1])
-        self.world.client.changeDynamics(uid, -1, mass=0)
+        """Take a target out of the cell at once (a missed-grip scenario); `TARGET.present` does it at the
+        next step, and writing it True puts the target back where the station placed it."""
+        key = f"{name}.present"
+        if key not in self._present:
+            raise KeyError(f"no target {name!r} in station {self.station.name!r}")
+        self._present[key] = False
+        self._place_targets()
+        self._publish()
+
+    def _place_targets(self) -> None:
+        """Apply `TARGET.present` writes: a removed target is parked far below the cell, static; one put
+        back returns to its station pose, at rest."""
+        for key, want in self._present.items():
+            if self._placed[key] == want:
+                continue
+            body = next(t for t in self.station.targets if f"{t.name}.present" == key)
+            uid, c = self.world.body_ids[body.name], self.world.client
+            if not want:
+                if self.gripper.state.gripped == body.name:
+                    self.gripper._release()
+                c.resetBasePositionAndOrientation(uid, [0, 0, -100], [0, 0, 0, 1])
+                c.changeDynamics(uid, -1, mass=0)
+            else:
+                c.changeDynamics(uid, -1, mass=body.mass)
+                c.resetBasePositionAndOrientation(uid, body.pose.xyz, pybullet.getQuaternionFromEuler(body.pose.rpy))
+                c.resetBaseVelocity(uid, [0, 0, 0], [0, 0, 0])
+            self._placed[key] = want
