@@ -142,7 +142,7 @@ class ControllerDevice:
         for sig in host.spec.io:
             wired = sig.drives or sig.source
             what = (f"drives {sig.drives}" if sig.drives else f"reads {sig.source}" if sig.source else "controller memory")
-            specs.append(SignalSpec(sig.name, OUTPUT if wired else INPUT, SIGNAL_TYPE[sig.type],
+            specs.append(SignalSpec(sig.name, OUTPUT if wired else INPUT, SIGNAL_TYPE[sig.type], sig.unit,
                                     description=f"robot controller {sig.type} {sig.name} ({what})", group="controller"))
         self.signals = tuple(specs)
 

@@ -68,7 +68,7 @@ class Gripper:
         self.mimics = [(joint_index[m.joint], master_input[m.master], m.multiplier, m.offset) for m in mechanism.mimics]
         self.finger_links = {f.name: [link_index[n] for n in f.links] for f in mechanism.fingers}
         self.finger_joint = {f.name: joint_index[f.joint] for f in mechanism.fingers}
-        self.active = spec.always_active
+        self.active_input = spec.always_active  # the `Active` input as last written
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
@@ -98,7 +98,12 @@ class Gripper:
         self.setpoint[name] = float(value)
 
     def set_active(self, active: bool) -> None:
-        self.active = bool(active) or self.spec.always_active
+        """Store the `Active` input; an always-active gripper keeps what was written but ignores it."""
+        self.active_input = bool(active)
+
+    @property
+    def active(self) -> bool:
+        return self.active_input or self.spec.always_active
 
     def command(self) -> None:
         """Send this step's servo commands (before physics)."""

@@ -107,6 +107,7 @@ class IOSignal:
     source: str | None = None
     scale: float = 1.0  # twin value = scale * controller value + offset (and back for `source`)
     offset: float = 0.0
+    unit: str = ""  # the controller's unit of an analogue signal (e.g. mm), for the register map
 
 
 @dataclass(frozen=True)
@@ -354,6 +355,7 @@ def load_station(path: str | Path) -> Station:
                 source=r.get("source", str, None),
                 scale=r.number("scale", 1.0),
                 offset=r.number("offset", 0.0),
+                unit=r.get("unit", str, ""),
             )
             if sig.drives and sig.type not in ("DO", "AO", "GO"):
                 raise r.error("drives", f"only an output (DO, AO, GO) can drive a twin input; {sig.name} is {sig.type}")

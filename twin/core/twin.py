@@ -198,7 +198,7 @@ class Twin:
             return device.read(name)
         if spec.direction == INPUT:
             if name == "Active":
-                return self.gripper.active
+                return self.gripper.active_input
             if name in self._present:
                 return self._present[name]
             return self.gripper.setpoint[name]
