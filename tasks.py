@@ -34,7 +34,7 @@ def main(argv: list[str]) -> int:
     ensure_venv()
     job, rest = argv[0], argv[1:]
     if job == "demo":
-        cmd = [str(PY), "-m", "twin", "demo", *rest]
+        cmd = [str(PY), "-m", "plc_client", "demo", *rest]
     elif job == "test":
         cmd = [str(PY), "-m", "pytest", "-q", *rest]
     else:

@@ -6,6 +6,7 @@
         watch NAME... [--interval S] [--count N]   a live view (one redrawn line on a terminal)
         run MODULE:NAME [--cycle S] [--seconds S]  run PLC logic (e.g. plc_client.ring_rig:sequence)
         map                               the signals it knows: table, address, type, unit, range, access
+    plc demo [--cycles N] [--realtime] [--remove-ring CYCLE]   the main job (see plc_client.cell_demo)
 
 The global options may also follow the command (`plc read L2 --port 5021`). Data goes to stdout; a
 problem is one line on stderr, `plc: error: ...`, with exit status 2 for a user error (unknown name, bad
@@ -71,6 +72,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("map", help="the signals the map knows: table, address, type, unit, range, access")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_map)
+    from .cell_demo import add_command
+    add_command(sub)
     return parser
 
 

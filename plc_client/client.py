@@ -14,11 +14,8 @@ is sent: an unknown name or an out-of-range value raises before the wire (see `p
 """
 from __future__ import annotations
 
-import contextlib
 import json
 import math
-import os
-import sys
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -93,10 +90,11 @@ class RegisterMap:
     def from_station(cls, station: str | Path) -> "RegisterMap":
         """Build the map the server would serve for this station (with the server's own map builder)."""
         from twin.core.errors import TwinError
+        from twin.core.world import quiet_native_stdout
         from twin.modbus import register_map as rm
 
         try:
-            with _quiet_stdout():
+            with quiet_native_stdout():
                 built = rm.build_map(station)
         except (TwinError, rm.MapError) as exc:
             raise MapError(str(exc)) from None
@@ -132,27 +130,6 @@ class RegisterMap:
         if not s.writable:
             raise NotWritableError(name)
         return _check(s, value)
-
-
-@contextlib.contextmanager
-def _quiet_stdout():
-    """Silence native writes to stdout meanwhile (pybullet prints its build time when first imported)."""
-    try:
-        sys.stdout.flush()
-    except (AttributeError, ValueError, OSError):
-        pass
-    try:
-        saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
-    except OSError:
-        yield
-        return
-    try:
-        os.dup2(devnull, 1)
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
 
 
 def _signal_from_dict(e: Any, where: str, i: int) -> Signal:

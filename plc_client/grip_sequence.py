@@ -12,6 +12,11 @@ margin further. It grips from outside (closing) and from inside (opening), with 
     (optional) IDLE/FAULT --prepare request--> PREPARING --in position--> IDLE
     A new request clears a fault (a release from a fault opens the fingers for the next attempt).
 
+With `done` the handshake is request/acknowledge, safe whatever the scan times on either side: the robot
+sets a request, waits for `done`, takes the request back and waits for `done` to fall. `done` is high
+while the request that started the last job is still high and that job is over (gripped, missed,
+released, prepared).
+
 Positions, speed and forces are in the units of the I/O it runs against: over the network, the register
 map's engineering units (mm, N); in process, `TwinIO` publishes the same units. Handshake signals are
 edge-triggered requests (a rising edge starts a grip or a release, so the robot may leave the bit set
@@ -66,6 +71,7 @@ class Handshake:
     state: str | None = None  # out, int: the `Phase`
     prepare_request: str | None = None  # in, bool: a rising edge moves the fingers to the ready position
     prepare_position: str | None = None  # in, number: where a prepare goes (else `ready_position[mode]`)
+    done: str | None = None  # out, bool: the job of the request that is still high is finished (its acknowledge)
 
 
 @dataclass
@@ -83,6 +89,7 @@ class GripState:
     last: float | None = None  # scan time of the previous scan
     edges: dict[str, bool] = field(default_factory=dict)  # previous value of each request input
     held_at: dict[str, float] = field(default_factory=dict)  # setpoints when the grip was confirmed
+    job: str | None = None  # the request input whose rising edge started the current (or last) job
     forces_at_grip: dict[str, float] = field(default_factory=dict)
 
 
@@ -94,6 +101,7 @@ class GripSequence:
     forces          force signal names, one per finger (the threshold applies to each)
     end_of_travel   per mode ("outside", "inside"): the setpoint where a grip that found no force is a miss
     speed           ramp speed of the setpoints while gripping and releasing (units per second)
+    travel_speed    ramp speed of a prepare move, where nothing is touched (default: `speed`)
     threshold       force every finger must reach for a confirmed grip
     close_direction per mode, +1 or -1: which way a grip moves the setpoints (outside closes: -1)
     contacts        optional contact signal names (bool, one per finger): a part is free only when none is set
@@ -117,6 +125,7 @@ class GripSequence:
     end_of_travel: Mapping[str, float]
     speed: float = 20.0
     threshold: float = 100.0
+    travel_speed: float | None = None
     close_direction: Mapping[str, int] = field(default_factory=lambda: {OUTSIDE: -1, INSIDE: +1})
     contacts: tuple[str, ...] | None = None
     free_force: float = 20.0
@@ -150,8 +159,8 @@ class GripSequence:
                 raise ValueError(f"end_of_travel needs a value for {mode!r}")
             if self.close_direction.get(mode) not in (-1, 1):
                 raise ValueError(f"close_direction[{mode!r}] must be +1 or -1")
-        if self.speed <= 0 or self.threshold <= 0:
-            raise ValueError("speed and threshold must be greater than 0")
+        if self.speed <= 0 or self.threshold <= 0 or (self.travel_speed is not None and self.travel_speed <= 0):
+            raise ValueError("speed, travel_speed and threshold must be greater than 0")
 
     # -- what a scan cycle needs to know ------------------------------------------------------------
     @property
@@ -165,7 +174,7 @@ class GripSequence:
     @property
     def outputs(self) -> tuple[str, ...]:
         h = self.handshake
-        names = [*self.axes, h.gripped, h.fault, h.busy, h.fault_code, h.state]
+        names = [*self.axes, h.gripped, h.fault, h.busy, h.fault_code, h.state, h.done]
         return tuple(n for n in names if n)
 
     def handshake_signals(self) -> dict:
@@ -174,7 +183,7 @@ class GripSequence:
         h = self.handshake
         values = {h.grip_request: False, h.release_request: False, h.inside: False, h.prepare_request: False,
                   h.prepare_position: 0.0, h.gripped: False, h.fault: False, h.busy: False, h.fault_code: 0,
-                  h.state: 0}
+                  h.state: 0, h.done: False}
         return {k: v for k, v in values.items() if k}
 
     def initial_state(self) -> GripState:
@@ -197,23 +206,26 @@ class GripSequence:
         if release_edge and state.phase in (Phase.HELD, Phase.GRIPPING, Phase.FAULT_MISSED, Phase.FAULT_STUCK,
                                             Phase.IDLE, Phase.PREPARING):
             self._start_release(state, actual, now)
+            state.job = h.release_request
         elif grip_edge and state.phase in (Phase.IDLE, Phase.FAULT_MISSED, Phase.FAULT_STUCK, Phase.PREPARING):
             state.mode = INSIDE if (h.inside and inputs[h.inside]) else OUTSIDE
             state.phase, state.fault, state.since, state.at_end_since = Phase.GRIPPING, Fault.NONE, now, None
             state.setpoint = dict(actual)
+            state.job = h.grip_request
         elif prepare_edge and state.phase in (Phase.IDLE, Phase.FAULT_MISSED, Phase.FAULT_STUCK):
             mode = INSIDE if (h.inside and inputs[h.inside]) else OUTSIDE
             goal = inputs[h.prepare_position] if h.prepare_position else self.ready_position.get(mode)
             if goal is not None:
                 state.phase, state.fault, state.goal, state.since = Phase.PREPARING, Fault.NONE, float(goal), now
                 state.setpoint, state.at_end_since = dict(actual), None
+                state.job = h.prepare_request
 
         if state.phase is Phase.GRIPPING:
             self._grip_scan(state, forces, actual, elapsed, now)
         elif state.phase is Phase.RELEASING:
             self._release_scan(inputs, state, forces, actual, elapsed, now)
         elif state.phase is Phase.PREPARING:
-            step = self.speed * elapsed
+            step = (self.travel_speed or self.speed) * elapsed
             for a in self.axes:
                 state.setpoint[a] = _towards(state.setpoint[a], state.goal, step)
             if self._arrived(state, {a: state.goal for a in self.axes}, actual, now):
@@ -231,6 +243,9 @@ class GripSequence:
             out[h.fault_code] = int(state.fault)
         if h.state:
             out[h.state] = int(state.phase)
+        if h.done:
+            busy = state.phase in (Phase.GRIPPING, Phase.RELEASING, Phase.PREPARING)
+            out[h.done] = bool(state.job and not busy and inputs[state.job])
         return out
 
     @staticmethod

@@ -6,7 +6,11 @@ the ring's 320 mm outer radius, or open from inside into its 240 mm bore (finger
 has missed the ring. A release opens at least back to where the next grip of the same kind starts
 (330 mm outside, 150 mm inside).
 
-    python -m plc_client --port 5020 --station stations/ring_rig_plc run plc_client.ring_rig:sequence
+`sequence()` uses the generic handshake names (grip_request, gripped, ...), for benches where a test
+plays the robot; `cell_sequence()` speaks the robot program of `stations/ring_rig_plc` (doGripRequest,
+diGripDone, ...), with the prepare request that puts the fingers where the robot asks (aoFingerReady):
+
+    plc --port 5020 --station stations/ring_rig_plc run plc_client.ring_rig:cell_sequence
 """
 from __future__ import annotations
 
@@ -19,10 +23,21 @@ CONTACTS = ("L2.contact", "L3.contact", "L5.contact")
 
 def sequence(handshake: Handshake | None = None, **overrides) -> GripSequence:
     """The ring rig's grip sequence; any `GripSequence` parameter can be overridden."""
-    params = dict(axes=AXES, forces=FORCES, contacts=CONTACTS, speed=20.0, threshold=200.0,
+    params = dict(axes=AXES, forces=FORCES, contacts=CONTACTS, speed=20.0, threshold=200.0, travel_speed=100.0,
                   end_of_travel={"outside": 290.0, "inside": 230.0},
                   ready_position={"outside": 330.0, "inside": 150.0},
                   release_limit={"outside": 441.0, "inside": 0.0},
                   handshake=handshake or Handshake())
     params.update(overrides)
     return GripSequence(**params)
+
+
+# The handshake with stations/ring_rig_plc/ring_rig_plc.mod (robot DOs are the PLC's inputs, and back).
+CELL_HANDSHAKE = Handshake(grip_request="doGripRequest", release_request="doReleaseRequest", inside="doGripInside",
+                           gripped="diGripOk", fault="diGripFault", busy=None, done="diGripDone",
+                           prepare_request="doPrepare", prepare_position="aoFingerReady")
+
+
+def cell_sequence(**overrides) -> GripSequence:
+    """The gripper PLC of `stations/ring_rig_plc`: the rig's grip sequence on the robot program's handshake."""
+    return sequence(CELL_HANDSHAKE, **overrides)

@@ -78,27 +78,58 @@ def plc_logic(inputs: Iterable[str], state: Callable[[], Any] | None = None):
     return mark
 
 
+def _initial_state(logic) -> Any:
+    make = getattr(logic, "initial_state", None)
+    return make() if make is not None else SimpleNamespace()
+
+
+class Combined:
+    """Several logics in one PLC program, run in order every scan on the same input image, each with its own
+    state; their outputs merge (a later logic wins a shared output). E.g. a cell sequencer beside the grip
+    sequence: `ScanCycle(io, Combined(ring_rig.cell_sequence(), operator))`."""
+
+    def __init__(self, *logics: Logic):
+        if not logics:
+            raise ValueError("Combined needs at least one logic")
+        for logic in logics:
+            if getattr(logic, "inputs", None) is None:
+                raise ValueError(f"{logic!r} does not say what it reads (.inputs; see plc_logic)")
+        self.logics = logics
+        self.inputs = tuple(dict.fromkeys(n for logic in logics for n in logic.inputs))
+        self.outputs = tuple(dict.fromkeys(n for logic in logics for n in getattr(logic, "outputs", ())))
+
+    def initial_state(self) -> list:
+        return [_initial_state(logic) for logic in self.logics]
+
+    def __call__(self, inputs: InputImage, state: list) -> dict:
+        out: dict = {}
+        for logic, own in zip(self.logics, state):
+            out.update(logic(inputs, own) or {})
+        return out
+
+
 class ScanCycle:
     """A virtual PLC: `io` is the process, `logic(inputs, state)` the program, `cycle` the scan time (s).
 
     `inputs`: the names read each scan (default: `logic.inputs`). `state`: the logic's memory (default:
     `logic.initial_state()`, else an empty namespace). `realtime`: pace against the wall clock (default:
-    when the I/O is not lockstep).
+    when the I/O is not lockstep). `speed`: real time only, the PLC's clock runs X times the wall clock,
+    to match a twin served at `--speed X`.
     """
 
     def __init__(self, io: ProcessIO, logic: Logic, cycle: float = DEFAULT_CYCLE, *,
-                 inputs: Iterable[str] | None = None, state: Any = None, realtime: bool | None = None):
+                 inputs: Iterable[str] | None = None, state: Any = None, realtime: bool | None = None,
+                 speed: float = 1.0):
         if not cycle > 0:
             raise ValueError(f"the cycle must be greater than 0 s, not {cycle!r}")
-        self.io, self.logic, self.cycle = io, logic, float(cycle)
+        if not speed > 0:
+            raise ValueError(f"the speed must be greater than 0, not {speed!r}")
+        self.io, self.logic, self.cycle, self.speed = io, logic, float(cycle), float(speed)
         names = inputs if inputs is not None else getattr(logic, "inputs", None)
         if names is None:
             raise ValueError("say which signals the logic reads: ScanCycle(io, logic, inputs=[...])")
         self.inputs = tuple(names)
-        if state is None:
-            make = getattr(logic, "initial_state", None)
-            state = make() if make is not None else SimpleNamespace()
-        self.state = state
+        self.state = _initial_state(logic) if state is None else state
         self.realtime = (not getattr(io, "lockstep", True)) if realtime is None else realtime
         self.scans = 0
         self.time = 0.0  # s since the first scan: scan count x cycle in lockstep, wall time in real time
@@ -128,15 +159,16 @@ class ScanCycle:
             self.io.advance(self.cycle)
             self.time = self.scans * self.cycle
             return
-        deadline = self._t0 + self.scans * self.cycle
+        period = self.cycle / self.speed  # wall seconds per scan
+        deadline = self._t0 + self.scans * period
         now = time.monotonic()
         if now < deadline:
             time.sleep(deadline - now)
         else:
             self.overruns += 1
-            if now - deadline > self.cycle:  # far behind: skip the lost cycles instead of bursting
-                self._t0 += math.floor((now - deadline) / self.cycle) * self.cycle
-        self.time = time.monotonic() - self._t0
+            if now - deadline > period:  # far behind: skip the lost cycles instead of bursting
+                self._t0 += math.floor((now - deadline) / period) * period
+        self.time = (time.monotonic() - self._t0) * self.speed
 
     def run(self, scans: int | None = None, *, seconds: float | None = None) -> None:
         """Run a number of scans, or for `seconds` of PLC time."""

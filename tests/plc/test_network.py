@@ -43,9 +43,10 @@ def test_a_batch_read_takes_one_request_per_run_of_addresses(client):
 
 def test_a_write_takes_effect_at_the_next_steps_in_lockstep(client):
     client.write(L2=325.0, L3=325.0)
-    assert client.read("L2", "L3") == {"L2": 330.0, "L3": 330.0}  # reads show the last completed step
+    assert client.read("L2", "L3") == {"L2": 325.0, "L3": 325.0}  # an input reads back what was written
+    assert client.get("L2.actual") == pytest.approx(330.0, abs=0.05)  # outputs: the last completed step
     client.advance(1)
-    assert client.read("L2", "L3") == {"L2": 325.0, "L3": 325.0}
+    assert client.get("L2.actual") < 330.0  # the fingers started to move in the step that followed
     client.advance(100)
     assert client.get("L2.actual") == pytest.approx(325.0, abs=0.1)
     client.write(L2=330.0, L3=330.0)

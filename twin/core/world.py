@@ -35,15 +35,29 @@ def quiet_native_stdout():
         sys.stdout.flush()
     except (AttributeError, ValueError, OSError):
         pass
-    saved = os.dup(fd)
-    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        saved = os.dup(fd)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+    except OSError:
+        yield
+        return
     try:
         os.dup2(devnull, fd)
         yield
     finally:
+        _flush_c_stdio()  # what C code buffered meanwhile goes to /dev/null, not to the restored stdout
         os.dup2(saved, fd)
         os.close(saved)
         os.close(devnull)
+
+
+def _flush_c_stdio() -> None:
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):  # no C library to ask (e.g. Windows): nothing buffered there
+        pass
 
 
 def quat(p: Placement) -> tuple[float, float, float, float]:

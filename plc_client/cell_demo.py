@@ -1,0 +1,264 @@
+"""The main job: the ring rig's full automatic cycle with its gripper PLC on the other side of the network.
+
+    plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE] [--station DIR]
+
+It starts `twin serve` for `stations/ring_rig_plc` as a subprocess (the twin and its RAPID robot
+controller), connects a scan-cycle PLC to it over Modbus/TCP, and runs as the cell's operator: it sets
+`fullAutoRun` and takes it back once the last cycle has started. In every cycle the robot picks the ring
+from outside on the right pallet, places it on the left, picks it from inside there and places it back
+on the right. Each grip, release and finger move is a request of the robot program to the PLC, which
+drives the finger setpoints over the network and confirms a grip only when every finger's force has
+passed the threshold; fingers that reach the end of travel without it are a missed grip, reported to
+the robot, which tries once more and then stops the cycle.
+
+It prints each step as it happens, the robot's TPWrite lines (relayed from the server's log) and the
+PLC's view, both stamped with simulated time, then a summary: cycles, grips, misses, cycle time in
+simulated and in wall seconds, and how far the ring ends from where it started. `--remove-ring K`
+takes the ring out of the cell (coil `ring.present`) when cycle K starts: the miss is detected and
+reported, never hidden.
+
+Lockstep (the default): the PLC advances the twin one scan at a time, so the run is repeatable to the
+bit and runs as fast as the machine allows. `--realtime`: the twin runs against the wall clock (at
+`--speed` times real time) and the PLC scans on its own clock, as a real PLC would.
+"""
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from . import ring_rig
+from .client import ClientIO
+from .grip_sequence import Phase
+from .scan import Combined, ScanCycle, plc_logic
+from .testing import twin_server
+
+DEFAULT_STATION = Path(__file__).resolve().parent.parent / "stations" / "ring_rig_plc"
+CYCLE_LIMIT_S = 120.0  # simulated seconds one cycle may take before the demo gives up
+WATCH = ("goCycle", "goCyclesDone", "goMisses", "doCycleFault", "sim.time_ms", "ring.x", "ring.y", "ring.z",
+         "ring.present", "L2.actual", "L3.actual", "L4.actual", "doGripInside", "aoFingerReady")
+
+
+def operator(cycles: int, remove_ring_at: int | None = None):
+    """The cell's operator as PLC logic: full automatic run until `cycles` have started; optionally the
+    ring is taken out of the cell when cycle `remove_ring_at` starts (a missing part)."""
+
+    @plc_logic(inputs=["goCycle"])
+    def run_cycles(inputs, state):
+        started = int(inputs["goCycle"])
+        out = {"fullAutoRun": started < cycles}
+        if remove_ring_at is not None:
+            out["ring.present"] = started < remove_ring_at
+        return out
+
+    return run_cycles
+
+
+@dataclass
+class Summary:
+    cycles_wanted: int
+    cycles_done: int = 0
+    grips: int = 0
+    misses: int = 0
+    stopped: bool = False  # the robot stopped the cycle (doCycleFault)
+    sim_time: float = 0.0
+    wall_time: float = 0.0
+    cycle_sim: list[float] = field(default_factory=list)
+    cycle_wall: list[float] = field(default_factory=list)
+    ring_error_mm: float | None = None  # None: the ring is not in the cell
+    ring_end: tuple[float, float, float] | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.cycles_done == self.cycles_wanted and self.ring_error_mm is not None and self.ring_error_mm < 5.0
+
+
+class CellDemo:
+    """Runs the cell and narrates it; `run()` returns the `Summary`."""
+
+    def __init__(self, station: str | Path = DEFAULT_STATION, cycles: int = 1, *, realtime: bool = False,
+                 speed: float = 1.0, remove_ring_at: int | None = None, scan_cycle: float = 0.010,
+                 out: Callable[[str], None] | None = None):
+        if cycles < 1:
+            raise ValueError("at least one cycle")
+        self.station, self.cycles, self.realtime, self.speed = Path(station), cycles, realtime, speed
+        self.remove_ring_at, self.scan_cycle = remove_ring_at, scan_cycle
+        self.out = out or (lambda line: print(line, flush=True))
+        self.now = 0.0  # simulated s, as last read from the server
+
+    def say(self, who: str, text: str) -> None:
+        self.out(f"[t={self.now:8.3f} s] {who}: {text}")
+
+    def run(self) -> Summary:
+        from twin.core.station import load_station
+
+        start_xyz = next(t.pose.xyz for t in load_station(self.station).targets if t.name == "ring")
+        mode = "lockstep: the PLC steps the twin" if not self.realtime else f"real time x{self.speed:g}"
+        self.out(f"demo: {self.station.name}, {self.cycles} cycle(s), {mode}, PLC scan {self.scan_cycle * 1000:g} ms")
+        with twin_server(self.station, lockstep=not self.realtime, speed=None if not self.realtime else self.speed) as server:
+            self.out(f"demo: twin serve (pid {server.process.pid}) listens on {server.host}:{server.port}; "
+                     "the gripper PLC connects over Modbus/TCP")
+            with server.client() as client:
+                return self._run(server, client, start_xyz)
+
+    def _run(self, server, client, start_xyz) -> Summary:
+        grip = ring_rig.cell_sequence()
+        logic = Combined(grip, operator(self.cycles, self.remove_ring_at))
+        plc = ScanCycle(ClientIO(client, lockstep=not self.realtime), logic, cycle=self.scan_cycle,
+                        inputs=tuple(dict.fromkeys((*logic.inputs, *WATCH))), speed=self.speed if self.realtime else 1.0)
+        grip_state = plc.state[0]
+        log = _LogTail(server.log)
+        s = Summary(self.cycles)
+        wall0 = time.perf_counter()
+        cycle_started: tuple[float, float] | None = None
+        seen = {"cycle": 0, "done": 0, "phase": Phase.IDLE}
+        limit = CYCLE_LIMIT_S * self.cycles
+        while True:
+            image = plc.scan()
+            self.now = image["sim.time_ms"] / 1000.0
+            for line in log.lines():
+                self.say("robot", line)
+            phase = grip_state.phase
+            if phase != seen["phase"]:
+                self._narrate_grip(seen["phase"], grip_state, image, s)
+                seen["phase"] = phase
+            if image["goCyclesDone"] != seen["done"]:
+                seen["done"] = s.cycles_done = image["goCyclesDone"]
+                if cycle_started is not None:
+                    s.cycle_sim.append(self.now - cycle_started[0])
+                    s.cycle_wall.append(time.perf_counter() - cycle_started[1])
+                    x, y, z = (image[f"ring.{a}"] for a in "xyz")
+                    self.say("demo", f"cycle {s.cycles_done} done in {s.cycle_sim[-1]:.2f} s simulated, "
+                                     f"{s.cycle_wall[-1]:.2f} s wall; ring at ({x:.1f}, {y:.1f}, {z:.1f}) mm")
+            if image["goCycle"] != seen["cycle"]:
+                seen["cycle"] = image["goCycle"]
+                cycle_started = (self.now, time.perf_counter())
+                if self.remove_ring_at == seen["cycle"]:
+                    self.say("operator", "takes the ring out of the cell (ring.present = 0)")
+            if image["doCycleFault"]:
+                s.stopped = True
+                break
+            if s.cycles_done >= self.cycles:
+                break
+            if self.now > limit:
+                self.say("demo", f"gave up: the cycles did not end within {limit:g} s of simulated time")
+                break
+        for line in log.lines():
+            self.say("robot", line)
+        final = client.read("ring.present", "ring.x", "ring.y", "ring.z", "sim.time_ms")
+        s.sim_time = final["sim.time_ms"] / 1000.0
+        s.wall_time = time.perf_counter() - wall0
+        if final["ring.present"]:
+            s.ring_end = (final["ring.x"], final["ring.y"], final["ring.z"])
+            s.ring_error_mm = math.dist(s.ring_end, [v * 1000.0 for v in start_xyz])
+        self._print_summary(s, start_xyz, plc)
+        return s
+
+    def _narrate_grip(self, before: Phase, st, image, s: Summary) -> None:
+        fingers = " / ".join(f"{image[f'{a}.actual']:.1f}" for a in ring_rig.AXES)
+        if st.phase is Phase.PREPARING:
+            self.say("plc", f"fingers to {st.goal:g} mm ({'inside' if image['doGripInside'] else 'outside'})")
+        elif st.phase is Phase.GRIPPING:
+            self.say("plc", f"grip from {st.mode}: closing on the ring at {grip_speed()} mm/s until every finger "
+                            f"reaches {grip_threshold()} N")
+        elif st.phase is Phase.HELD:
+            s.grips += 1
+            forces = " / ".join(f"{v:.0f}" for v in st.forces_at_grip.values())
+            self.say("plc", f"grip confirmed from {st.mode}: fingers at {fingers} mm, forces {forces} N")
+        elif st.phase is Phase.FAULT_MISSED:
+            s.misses += 1
+            self.say("plc", f"MISSED GRIP from {st.mode}: end of travel at {fingers} mm without force; fault to the robot")
+        elif st.phase is Phase.RELEASING:
+            self.say("plc", "release: opening until the ring is free")
+        elif st.phase is Phase.FAULT_STUCK:
+            self.say("plc", f"RELEASE STUCK: the ring still touches a finger at {fingers} mm")
+        elif st.phase is Phase.IDLE and before is Phase.RELEASING:
+            self.say("plc", f"released: fingers at {fingers} mm")
+        elif st.phase is Phase.IDLE and before is Phase.PREPARING:
+            self.say("plc", f"fingers ready at {fingers} mm")
+
+    def _print_summary(self, s: Summary, start_xyz, plc: ScanCycle) -> None:
+        def avg(v):
+            return sum(v) / len(v) if v else float("nan")
+
+        ring = ("not in the cell" if s.ring_end is None else
+                f"{s.ring_error_mm:.1f} mm from its start "
+                f"(at {s.ring_end[0]:.1f}, {s.ring_end[1]:.1f}, {s.ring_end[2]:.1f} mm; start "
+                f"{start_xyz[0] * 1000:.1f}, {start_xyz[1] * 1000:.1f}, {start_xyz[2] * 1000:.1f})")
+        self.out("summary:")
+        self.out(f"  cycles      {s.cycles_done} of {s.cycles_wanted} completed"
+                 + ("; the robot stopped the cycle after a missed grip" if s.stopped else ""))
+        self.out(f"  grips       {s.grips} confirmed by force, {s.misses} missed")
+        if s.cycle_sim:
+            self.out(f"  cycle time  {avg(s.cycle_sim):.2f} s simulated, {avg(s.cycle_wall):.2f} s wall (mean of "
+                     f"{len(s.cycle_sim)})")
+        self.out(f"  total       {s.sim_time:.2f} s simulated in {s.wall_time:.2f} s wall "
+                 f"({s.sim_time / s.wall_time:.1f}x real time), {plc.scans} PLC scans")
+        self.out(f"  ring        {ring}")
+
+
+def grip_speed() -> str:
+    return f"{ring_rig.sequence().speed:g}"
+
+
+def grip_threshold() -> str:
+    return f"{ring_rig.sequence().threshold:g}"
+
+
+class _LogTail:
+    """New lines of the server's log that the robot program wrote (its TPWrite and errors)."""
+
+    MARK = "robot"
+
+    def __init__(self, path: Path):
+        self.path, self.offset, self.rest = path, 0, ""
+
+    def lines(self) -> list[str]:
+        with open(self.path, "r", encoding="utf-8", errors="replace") as f:
+            f.seek(self.offset)
+            text = f.read()
+            self.offset = f.tell()
+        text, self.rest = self.rest + text, ""
+        if text and not text.endswith("\n"):
+            text, _, self.rest = text.rpartition("\n")
+        found = []
+        for line in text.splitlines():
+            # "twin serve: [t=2.064 s] robot: Gripped ..." -> "Gripped ..."
+            head, sep, tail = line.partition("] robot")
+            if sep:
+                found.append(tail.lstrip(": ").strip())
+        return found
+
+
+def main(args) -> int:
+    demo = CellDemo(args.station, args.cycles, realtime=args.realtime, speed=args.speed,
+                    remove_ring_at=args.remove_ring, scan_cycle=args.scan)
+    summary = demo.run()
+    if args.remove_ring is not None:
+        return 0 if summary.misses > 0 and summary.stopped else 1  # the fault had to be detected
+    return 0 if summary.ok else 1
+
+
+def add_command(sub) -> None:
+    p = sub.add_parser("demo", help="the ring rig's full automatic cycle: twin server, RAPID robot, PLC over Modbus/TCP",
+                       description=__doc__.split("\n\n")[1])
+    p.add_argument("--station", default=str(DEFAULT_STATION), help="the cell (default stations/ring_rig_plc)")
+    p.add_argument("--cycles", type=int, default=1, help="full cycles to run (default 1)")
+    p.add_argument("--realtime", action="store_true", help="run the twin against the wall clock (default: lockstep)")
+    p.add_argument("--speed", type=float, default=1.0, help="with --realtime: X times real time (default 1)")
+    p.add_argument("--remove-ring", type=int, metavar="CYCLE", default=None,
+                   help="take the ring out of the cell when this cycle starts: a missed grip, detected and reported")
+    p.add_argument("--scan", type=float, default=0.010, help="PLC scan cycle, s (default 0.010)")
+    p.set_defaults(func=main)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="cell_demo")
+    add_command(parser.add_subparsers(dest="command", required=True))
+    a = parser.parse_args(["demo", *sys.argv[1:]])
+    sys.exit(a.func(a))

@@ -1,0 +1,88 @@
+"""The whole cell across real sockets: `twin serve stations/ring_rig_plc` (physics and the RAPID robot
+controller) in a subprocess, the gripper PLC scanning over Modbus/TCP, and the demo as the operator.
+
+Finger setpoints travel RAPID -> twin -> Modbus/TCP -> PLC -> twin: the robot asks, the PLC drives L2..L4.
+"""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+from plc_client.cell_demo import CellDemo
+from tests.conftest import ROOT
+
+CELL = ROOT / "stations" / "ring_rig_plc"
+
+
+def run_cell(**kw):
+    lines: list[str] = []
+    summary = CellDemo(CELL, out=lines.append, **kw).run()
+    return summary, lines
+
+
+def narration(lines: list[str]) -> list[str]:
+    """The stamped lines, without what depends on the machine (wall time, port, pid)."""
+    return [re.sub(r"[\d.]+ s wall", "W s wall", line) for line in lines if line.startswith("[t=")]
+
+
+@pytest.fixture(scope="module")
+def one_cycle():
+    return run_cell(cycles=1)
+
+
+def test_the_full_cycle_moves_the_ring_across_and_back_with_every_grip_confirmed_by_force(one_cycle):
+    s, lines = one_cycle
+    assert s.cycles_done == 1 and s.grips == 2 and s.misses == 0 and not s.stopped
+    assert s.ring_error_mm is not None and s.ring_error_mm < 2.0  # back on the right pallet, where it started
+    text = "\n".join(lines)
+    # each grip was the PLC's: confirmed once every finger force passed the threshold, then reported
+    # to the robot, which only then went on
+    confirmed = [line for line in lines if "grip confirmed" in line]
+    assert [("outside" in c, "inside" in c) for c in confirmed] == [(True, False), (False, True)]
+    for c in confirmed:
+        forces = [float(f) for f in re.search(r"forces ([\d / ]+) N", c).group(1).split(" / ")]
+        assert len(forces) == 3 and min(forces) >= 200.0
+    assert text.index("grip confirmed from outside") < text.index("robot: Gripped the ring, attempt 1")
+    # the fingers went where the robot asked (aoFingerReady): 330 mm around the ring, 150 mm into its bore
+    assert re.search(r"fingers ready at 33\d\.\d / 33\d\.\d / 33\d\.\d mm", text)
+    assert re.search(r"fingers ready at 15\d\.\d / 15\d\.\d / 15\d\.\d mm", text)
+    # outside the ring's 320 mm radius, inside its 240 mm bore (fingers' outer faces at setpoint + 40)
+    assert re.search(r"grip confirmed from outside: fingers at 3(19|20)\.\d", text)
+    assert re.search(r"grip confirmed from inside: fingers at (199|200)\.\d", text)
+    assert "summary:" in text and "2 confirmed by force, 0 missed" in text
+
+
+def test_the_cycle_in_lockstep_is_the_same_on_every_run(one_cycle):
+    s1, lines1 = one_cycle
+    s2, lines2 = run_cell(cycles=1)
+    assert narration(lines1) == narration(lines2)
+    assert (s1.ring_end, s1.cycle_sim, s1.sim_time) == (s2.ring_end, s2.cycle_sim, s2.sim_time)
+
+
+def test_a_missed_grip_raises_the_fault_and_the_robot_does_not_carry_on():
+    s, lines = run_cell(cycles=1, remove_ring_at=1)  # the ring is taken away before the first pick
+    text = "\n".join(lines)
+    assert s.misses == 2 and s.grips == 0  # the first attempt and the retry
+    assert text.count("MISSED GRIP from outside: end of travel at 29") == 2  # fingers at end of travel
+    assert "robot: Missed grip, attempt 1" in text and "robot: Missed grip, attempt 2" in text
+    assert s.stopped and s.cycles_done == 0 and "robot: Cycle stopped: no ring to pick" in text
+    # it never went on to place a ring it does not hold: no release was ever asked for
+    assert "release" not in text
+    assert s.ring_end is None and not s.ok
+
+
+def test_the_demo_command_prints_its_steps_and_a_summary():
+    out = subprocess.run([sys.executable, "-m", "plc_client", "demo", "--cycles", "1"], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = out.stdout.splitlines()
+    assert any("robot: Cycle 1" in line for line in lines)
+    summary = "\n".join(lines[lines.index("summary:"):])
+    assert re.search(r"cycles\s+1 of 1 completed", summary)
+    assert re.search(r"grips\s+2 confirmed by force, 0 missed", summary)
+    assert re.search(r"cycle time\s+\d+\.\d+ s simulated, \d+\.\d+ s wall", summary)
+    m = re.search(r"ring\s+(\d+\.\d) mm from its start", summary)
+    assert m and float(m.group(1)) < 2.0
