@@ -1,10 +1,17 @@
 """The gripper's behaviour, evaluated every simulation step (the SmartComponent's OnSimulationStep).
 
-Before physics (`command`): each input is a servo setpoint. The joint is driven towards it by a
-position servo limited in velocity and force (URDF velocity and effort, or the station's override), so
-it never jumps, and it stops on contact once the force limit is reached: unlike RobotStudio, each
-finger stops by itself and the force it applies is known. Mimic joints follow their master's setpoint.
-While `Active` is low every joint holds the position it had when `Active` fell.
+Before physics (`command`): each input is a servo setpoint. The joint moves towards it at its velocity
+limit with at most its effort limit (URDF velocity and effort, or the station's overrides), so it never
+jumps and it stops by itself against a part: unlike RobotStudio, each finger stops on contact and its
+force is known. Mimic joints follow their master. While `Active` is low every joint holds its command.
+
+The force of a joint is its servo's: a command position moves towards the setpoint at the velocity
+limit, the joint follows it, and the force is `effort * following error / FULL_FORCE_ERROR` (2 mm or
+0.02 rad), up to the effort limit. A free finger follows its command closely and reads almost nothing; a
+finger blocked by a part stops while its command runs on (no further than full force, so a new setpoint
+acts at once), and its force builds up to the effort limit, the way a real servo's torque builds when it
+presses on something. That is what a PLC's torque threshold reads. (pybullet's own motor force against a
+contact depends on its solver and the finger's mass, not on the effort: it is not what is reported.)
 
 After physics (`sense`): per finger, a contact flag (a real geometric contact: closest distance to a
 target object within `contact_distance`, 0.5 mm by default, never the early contacts pybullet reports
@@ -26,6 +33,8 @@ IN_POSITION_TOLERANCE = {"m": 0.0002, "rad": 0.002}  # 0.2 mm, ~0.1 degree
 MOVING_SPEED = {"m": 0.001, "rad": 0.005}  # below this the axis counts as standing still
 DEFAULT_VELOCITY = {"m": 0.1, "rad": 1.0}  # when the URDF gives no velocity limit
 DEFAULT_EFFORT = {"m": 100.0, "rad": 10.0}  # when the URDF gives no effort limit
+FULL_FORCE_ERROR = {"m": 0.002, "rad": 0.02}  # following error at which a servo applies its effort limit
+POSITION_GAIN = 0.3  # pybullet motor: the velocity it asks for is POSITION_GAIN * error / substep
 
 
 @dataclass
@@ -70,6 +79,13 @@ class Gripper:
         self.finger_joint = {f.name: joint_index[f.joint] for f in mechanism.fingers}
         self.active_input = spec.always_active  # the `Active` input as last written
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
+        self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
+        self.unit = {inp.name: inp.unit for inp in mechanism.inputs}
+        params = client.getPhysicsEngineParameters()
+        self.dt = float(params["fixedTimeStep"])
+        # how far pybullet's motor trails a target moving at 1 unit/s: it asks for POSITION_GAIN * error / h
+        self._lag_per_speed = self.dt / max(1, int(params["numSubSteps"])) / POSITION_GAIN
+        self._command_speed: dict[str, float] = {inp.name: 0.0 for inp in mechanism.inputs}
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
         self.state = GripState()
@@ -106,21 +122,53 @@ class Gripper:
         return self.active_input or self.spec.always_active
 
     def command(self) -> None:
-        """Send this step's servo commands (before physics)."""
+        """Send this step's servo commands (before physics): move each command position on by at most the
+        velocity limit, and let each servo push with the force its following error calls for."""
         if not self.active and self._hold is None:
-            self._hold = {name: axis.actual for name, axis in self.state.axes.items()}
+            self._hold = dict(self.command_position)
         elif self.active:
             self._hold = None
         goal = self._hold if self._hold is not None else self.setpoint
-        c = self.client
+        c, dt = self.client, self.dt
         for name, joint in self.joint.items():
             velocity, effort = self.limits[name]
-            c.setJointMotorControl2(self.body, joint, pybullet.POSITION_CONTROL, targetPosition=goal[name],
-                                    force=effort, maxVelocity=velocity, positionGain=0.3, velocityGain=1.0)
+            full = FULL_FORCE_ERROR[self.unit[name]]
+            target = _towards(self.command_position[name], goal[name], velocity * dt)
+            # a blocked joint's command runs on only as far as full force: a new setpoint acts at once
+            actual = c.getJointState(self.body, joint)[0]
+            target = min(max(target, actual - full), actual + full)
+            self._command_speed[name] = abs(target - self.command_position[name]) / dt
+            self.command_position[name] = target
+            self._drive(joint, goal[name], velocity, effort)
         for joint, master, mult, off in self.mimics:
             velocity, effort = self.limits[master]
-            c.setJointMotorControl2(self.body, joint, pybullet.POSITION_CONTROL, targetPosition=mult * goal[master] + off,
-                                    force=effort, maxVelocity=velocity * abs(mult), positionGain=0.3, velocityGain=1.0)
+            self._drive(joint, mult * goal[master] + off, velocity * abs(mult), effort)
+
+    def _force(self, joint: int, actual: float) -> float:
+        """The servo force of a joint after the step: effort * following error / full-force error. The lag a
+        free joint has behind a moving command (the motor's, not a load's) does not count."""
+        command, speed, effort, full_error = self._servo_of(joint)
+        error = max(0.0, abs(command - actual) - speed * self._lag_per_speed)
+        return effort * min(1.0, error / full_error)
+
+    def _servo_of(self, joint: int) -> tuple[float, float, float, float]:
+        """(command position, its speed, effort limit, full-force error) of an input's or a mimic's joint."""
+        for name, j in self.joint.items():
+            if j == joint:
+                return (self.command_position[name], self._command_speed[name], self.limits[name][1],
+                        FULL_FORCE_ERROR[self.unit[name]])
+        for j, master, mult, off in self.mimics:
+            if j == joint:
+                return (mult * self.command_position[master] + off, abs(mult) * self._command_speed[master],
+                        self.limits[master][1], FULL_FORCE_ERROR[self.unit[master]] * abs(mult))
+        return 0.0, 0.0, 0.0, 1.0  # not driven
+
+    def _drive(self, joint: int, goal: float, velocity: float, effort: float) -> None:
+        """Command one joint towards `goal` at its velocity limit with at most its effort limit. (pybullet's motor
+        is an implicit velocity constraint: stable for any finger mass, and it holds a carried part with the
+        full effort, but the force it reports against a contact depends on the solver, not on the servo.)"""
+        self.client.setJointMotorControl2(self.body, joint, pybullet.POSITION_CONTROL, targetPosition=goal,
+                                          force=effort, maxVelocity=velocity, positionGain=POSITION_GAIN, velocityGain=1.0)
 
     def _touching(self, finger: str) -> tuple[str, ...]:
         c, d = self.client, self.spec.contact_distance
@@ -139,11 +187,11 @@ class Gripper:
         c = self.client
         axes = {}
         for name, joint in self.joint.items():
-            pos, vel, _, torque = c.getJointState(self.body, joint)
-            axes[name] = AxisState(pos, vel, abs(torque))
+            pos, vel, _, _ = c.getJointState(self.body, joint)
+            axes[name] = AxisState(pos, vel, self._force(joint, pos))
         fingers = {}
         for finger, joint in self.finger_joint.items():
-            fingers[finger] = FingerState(self._touching(finger), abs(c.getJointState(self.body, joint)[3]))
+            fingers[finger] = FingerState(self._touching(finger), self._force(joint, c.getJointState(self.body, joint)[0]))
         self.state.axes, self.state.fingers = axes, fingers
         common = set(self.targets)
         for f in fingers.values():
@@ -175,3 +223,8 @@ class Gripper:
             self.client.removeConstraint(self._constraint)
         self._constraint = None
         self.state.gripped = ""
+
+
+def _towards(value: float, goal: float, step: float) -> float:
+    """`value` moved towards `goal` by at most `step`, landing exactly on it."""
+    return goal if abs(goal - value) <= step else value + (step if goal > value else -step)
