@@ -11,7 +11,8 @@ limit, the joint follows it, and the force is `effort * following error / FULL_F
 finger blocked by a part stops while its command runs on (no further than full force, so a new setpoint
 acts at once), and its force builds up to the effort limit, the way a real servo's torque builds when it
 presses on something. That is what a PLC's torque threshold reads. (pybullet's own motor force against a
-contact depends on its solver and the finger's mass, not on the effort: it is not what is reported.)
+contact depends on its solver and the finger's mass, not on the effort: it is not what is reported. How
+far a finger sinks into a part, and so the force part-way up, still depends on the contact's softness.)
 
 After physics (`sense`): per finger, a contact flag (a real geometric contact: closest distance to a
 target object within `contact_distance`, 0.5 mm by default, never the early contacts pybullet reports
@@ -134,9 +135,13 @@ class Gripper:
             velocity, effort = self.limits[name]
             full = FULL_FORCE_ERROR[self.unit[name]]
             target = _towards(self.command_position[name], goal[name], velocity * dt)
-            # a blocked joint's command runs on only as far as full force: a new setpoint acts at once
             actual = c.getJointState(self.body, joint)[0]
+            # a blocked joint's command runs on only as far as full force: a new setpoint acts at once
             target = min(max(target, actual - full), actual + full)
+            # and a joint already further on its way than its command (leaving a part) pulls the command along
+            ahead = (actual - target) * (goal[name] - target)
+            if ahead > 0:
+                target = actual if abs(goal[name] - target) > abs(actual - target) else goal[name]
             self._command_speed[name] = abs(target - self.command_position[name]) / dt
             self.command_position[name] = target
             self._drive(joint, goal[name], velocity, effort)
