@@ -13,21 +13,42 @@ from pathlib import Path
 from .core.errors import TwinError
 
 
+INFO_TARGETS = "a gripper .urdf, a station folder or a station.toml"
+
+
 def _mechanism_of(target: str):
+    from .core.errors import StationError
     from .core.mechanism import load_mechanism
-    from .core.station import load_station
+    from .core.station import gripper_mechanism, load_station
 
     path = Path(target)
     if path.suffix.lower() == ".urdf":
         return load_mechanism(path)
-    station = load_station(path)
-    return load_mechanism(station.gripper.urdf, station.gripper.fingers)
+    if path.is_dir() and not (path / "station.toml").exists():
+        raise StationError(target, "", f"a folder without station.toml: twin info needs {INFO_TARGETS}")
+    if not path.is_dir() and path.suffix.lower() != ".toml":
+        raise StationError(target, "", f"twin info needs {INFO_TARGETS}, not a {path.suffix or 'file without suffix'}")
+    return gripper_mechanism(load_station(path))
+
+
+def _remarks(mech) -> list[str]:
+    """What `twin info` adds below the table: choices the twin made, and why a station may refuse it."""
+    lines = [f"note: input {i.name}: {i.note}" for i in mech.inputs if i.note]
+    if mech.rigid_joints:
+        lines.append("note: " + ", ".join(f"joint {j} ({t})" for j, t in mech.rigid_joints)
+                     + ": treated as rigid (only prismatic, revolute and continuous joints become inputs)")
+    if not mech.fingers:
+        lines.append("warning: no finger detected (no movable link, with the links fixed to it, has collision "
+                     "geometry): a station with this gripper must name its fingers (gripper.fingers)")
+    return lines
 
 
 def cmd_info(args) -> int:
     mech = _mechanism_of(args.target)
     if args.json:
         print(json.dumps(mech.as_dict(), indent=2))
+        for line in _remarks(mech):
+            print(line, file=sys.stderr)  # stdout stays pure JSON
         return 0
     print(f"gripper: {mech.robot_name} ({mech.urdf})")
     print(f"base link (attach point): {mech.base_link}")
@@ -42,6 +63,8 @@ def cmd_info(args) -> int:
         print(f"mimic: {m.joint} follows {m.master} (x{m.multiplier:g} {m.offset:+g}), no input of its own")
     print(f"fingers ({len(mech.fingers)}): " + ", ".join(
         f.name + (f" (+{', '.join(f.links[1:])})" if len(f.links) > 1 else "") for f in mech.fingers))
+    for line in _remarks(mech):
+        print(line)
     return 0
 
 
@@ -58,7 +81,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("target", help="a gripper .urdf file, a station.toml or a station folder")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=cmd_info)
-    p = sub.add_parser("demo", help="run the headless demo of the ring rig and print what happens")
+    p = sub.add_parser("demo", help="run the headless demo of the ring rig (stations/ring_rig or a station like it) and print what happens")
     p.add_argument("station", nargs="?", default=str(Path(__file__).resolve().parent.parent / "stations" / "ring_rig"))
     p.add_argument("--cycles", type=int, default=1, help="how many full cycles to run")
     p.set_defaults(func=cmd_demo)

@@ -11,7 +11,8 @@ import math
 import time
 from pathlib import Path
 
-from .core import Twin
+from .core.errors import StationError
+from .core.station import Station, gripper_mechanism, load_station
 
 FINGERS = ("L2", "L3", "L4")
 STEP_MM = 0.001  # the thesis's 1 mm per increment
@@ -19,7 +20,7 @@ INCREMENT_TIME = 0.2  # s between increments
 
 
 class Script:
-    def __init__(self, twin: Twin):
+    def __init__(self, twin):
         self.twin = twin
 
     def say(self, text: str) -> None:
@@ -64,9 +65,34 @@ class Script:
         self.say(f"released at {value * 1000:.0f} mm")
 
 
+ROBOT_TARGETS = ("app_right", "grip_right", "app_left", "grip_left")
+
+
+def check_ring_rig(station: Station) -> None:
+    """This script plays the ring rig only; any other station would fail half-way with a KeyError."""
+    missing = []
+    if station.robot is None:
+        missing.append("a robot")
+    if "ring" not in {t.name for t in station.targets}:
+        missing.append("a target named ring")
+    targets = [t for t in ROBOT_TARGETS if t not in station.robot_targets]
+    if targets:
+        missing.append("robot targets " + ", ".join(targets))
+    inputs = [name for name in FINGERS if name not in {i.name for i in gripper_mechanism(station).inputs}]
+    if inputs:
+        missing.append("gripper inputs " + ", ".join(inputs))
+    if missing:
+        raise StationError(str(station.file), "", "twin demo plays the ring rig (stations/ring_rig) and needs "
+                           + "; ".join(missing) + " (the cell's main demo is `plc demo`)")
+
+
 def run_demo(station: str | Path, cycles: int = 1) -> int:
     wall0 = time.perf_counter()
-    with Twin.from_station(station) as twin:
+    st = load_station(station)
+    check_ring_rig(st)
+    from .core.twin import Twin  # after the check: importing pybullet prints a banner
+
+    with Twin(st) as twin:
         s = Script(twin)
         s.say(f"station {twin.station.name}: inputs {', '.join(i.name for i in twin.mechanism.inputs)}, "
               f"fingers {', '.join(f.name for f in twin.mechanism.fingers)}")

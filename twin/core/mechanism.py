@@ -8,7 +8,13 @@ kinematic tree, joint limits and `<mimic>` tags, which pybullet ignores) and der
 - the *mimic* joints, each following its master (never an input of its own);
 - the *base link* (the tree's root), where a gripped part is attached;
 - the *fingers*: a movable joint's child link together with the links rigidly fixed to it, counted as
-  a finger when that rigid group has collision geometry (or as named by the station).
+  a finger when that rigid group has collision geometry (or as named by the station: any link of the
+  group names its finger, which keeps the movable link's name).
+
+Planar and floating joints (and pybullet's spherical ones) are no inputs: they are treated as rigid,
+and the world loads them as fixed joints (`Mechanism.rigid_joints` lists them). A continuous
+joint's input gets the range -pi to pi. A mimic follower must stay within its own URDF limits, so the
+master's input range is narrowed to what every follower allows (`JointInput.note` says so).
 
 It needs no physics connection, so `twin info` works on any URDF in milliseconds.
 """
@@ -22,6 +28,10 @@ from pathlib import Path
 from .errors import MechanismError
 
 MOVABLE = ("prismatic", "revolute", "continuous")
+NOT_DRIVEN = ("planar", "floating", "spherical")  # spherical: pybullet's extension; the twin makes these fixed
+RIGID = ("fixed",) + NOT_DRIVEN
+#: The twin's own signal names: a link named so would give a second signal of the same name.
+RESERVED_NAMES = ("Active", "doGripped", "GrippedPart")
 
 
 @dataclass(frozen=True)
@@ -36,6 +46,7 @@ class JointInput:
     unit: str  # "m" or "rad"
     velocity: float  # URDF velocity limit (m/s or rad/s), 0 if the URDF gives none
     effort: float  # URDF effort limit (N or N*m), 0 if the URDF gives none
+    note: str = ""  # where the range does not come straight from the URDF's limits, why
 
 
 @dataclass(frozen=True)
@@ -65,6 +76,7 @@ class Mechanism:
     inputs: tuple[JointInput, ...]
     mimics: tuple[Mimic, ...]
     fingers: tuple[Finger, ...]
+    rigid_joints: tuple[tuple[str, str], ...] = ()  # (joint, type) of planar, floating, spherical joints
 
     def input(self, name: str) -> JointInput:
         for inp in self.inputs:
@@ -95,6 +107,7 @@ class _Joint:
     velocity: float
     effort: float
     mimic: tuple[str, float, float] | None
+    has_range: bool  # the URDF gives lower or upper (a mimic follower's range is checked only then)
 
 
 def _float(elem: ET.Element, attr: str, default: float, where: str) -> float:
@@ -102,9 +115,12 @@ def _float(elem: ET.Element, attr: str, default: float, where: str) -> float:
     if text is None:
         return default
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
         raise MechanismError(f"{where}: attribute {attr}={text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise MechanismError(f"{where}: attribute {attr}={text!r} is not a finite number")
+    return value
 
 
 def _parse(urdf: Path) -> tuple[str, dict[str, bool], list[_Joint]]:
@@ -112,6 +128,10 @@ def _parse(urdf: Path) -> tuple[str, dict[str, bool], list[_Joint]]:
         root = ET.parse(urdf).getroot()
     except FileNotFoundError:
         raise MechanismError(f"{urdf}: no such file") from None
+    except IsADirectoryError:
+        raise MechanismError(f"{urdf}: is a folder, not a URDF file") from None
+    except OSError as exc:
+        raise MechanismError(f"{urdf}: cannot be read: {exc.strerror or exc}") from None
     except ET.ParseError as exc:
         raise MechanismError(f"{urdf}: not valid XML: {exc}") from None
     if root.tag != "robot":
@@ -129,6 +149,8 @@ def _parse(urdf: Path) -> tuple[str, dict[str, bool], list[_Joint]]:
         parent, child = j.find("parent"), j.find("child")
         if not name or not jtype or parent is None or child is None:
             raise MechanismError(f"{where}: needs name, type, <parent> and <child>")
+        if jtype not in MOVABLE + RIGID:
+            raise MechanismError(f"{where}: type {jtype!r} is not a URDF joint type ({', '.join(MOVABLE + RIGID)})")
         limit = j.find("limit")
         lower = upper = velocity = effort = 0.0
         if limit is not None:
@@ -136,8 +158,9 @@ def _parse(urdf: Path) -> tuple[str, dict[str, bool], list[_Joint]]:
             upper = _float(limit, "upper", 0.0, where)
             velocity = _float(limit, "velocity", 0.0, where)
             effort = _float(limit, "effort", 0.0, where)
+        has_range = limit is not None and (limit.get("lower") is not None or limit.get("upper") is not None)
         if jtype == "continuous":
-            lower, upper = -math.pi, math.pi
+            lower, upper, has_range = -math.pi, math.pi, False
         elif jtype in MOVABLE and limit is None:
             raise MechanismError(f"{where}: a {jtype} joint needs a <limit> with lower and upper")
         if jtype in MOVABLE and lower > upper:
@@ -147,7 +170,7 @@ def _parse(urdf: Path) -> tuple[str, dict[str, bool], list[_Joint]]:
         if m is not None and jtype in MOVABLE:
             mimic = (m.get("joint", ""), _float(m, "multiplier", 1.0, where), _float(m, "offset", 0.0, where))
         joints.append(_Joint(name, jtype, parent.get("link", ""), child.get("link", ""),
-                             lower, upper, velocity, effort, mimic))
+                             lower, upper, velocity, effort, mimic, has_range))
     return root.get("name", urdf.stem), links, joints
 
 
@@ -164,6 +187,8 @@ def load_mechanism(urdf: str | Path, finger_names: tuple[str, ...] | None = None
         for end in (j.parent, j.child):
             if end not in links:
                 raise MechanismError(f"{urdf}: joint {j.name!r} names link {end!r}, which is not defined")
+    if not any(j.type in MOVABLE for j in joints):
+        raise MechanismError(f"{urdf}: has no movable joint (prismatic or revolute): nothing to drive")
 
     def root_master(j: _Joint) -> _Joint:
         seen = {j.name}
@@ -177,14 +202,16 @@ def load_mechanism(urdf: str | Path, finger_names: tuple[str, ...] | None = None
             j = master
         return j
 
-    inputs, mimics = [], []
+    ranges: dict[str, tuple[float, float]] = {}
+    notes: dict[str, list[str]] = {}
+    mimics = []
     for j in joints:
         if j.type not in MOVABLE:
             continue
         if j.mimic is None:
-            kind = "prismatic" if j.type == "prismatic" else "revolute"
-            inputs.append(JointInput(j.child, j.name, kind, j.lower, j.upper,
-                                     "m" if kind == "prismatic" else "rad", j.velocity, j.effort))
+            ranges[j.name] = (j.lower, j.upper)
+            if j.type == "continuous":
+                notes.setdefault(j.name, []).append("continuous joint: range -pi to pi")
         else:
             # Compose chained mimics so every follower refers to an independent joint.
             master, mult, off = root_master(j), j.mimic[1], j.mimic[2]
@@ -193,6 +220,21 @@ def load_mechanism(urdf: str | Path, finger_names: tuple[str, ...] | None = None
                 mult, off = mult * k.mimic[1], mult * k.mimic[2] + off
                 k = by_name[k.mimic[0]]
             mimics.append(Mimic(j.name, master.name, mult, off))
+    for m in mimics:
+        _narrow_for_follower(urdf, by_name[m.joint], m, ranges, notes)
+
+    inputs = []
+    for j in joints:
+        if j.type in MOVABLE and j.mimic is None:
+            kind = "prismatic" if j.type == "prismatic" else "revolute"
+            lo, hi = ranges[j.name]
+            inputs.append(JointInput(j.child, j.name, kind, lo, hi, "m" if kind == "prismatic" else "rad",
+                                     j.velocity, j.effort, "; ".join(notes.get(j.name, []))))
+    for inp in inputs:
+        if inp.name in RESERVED_NAMES:
+            raise MechanismError(f"{urdf}: link {inp.name!r} (moved by joint {inp.joint!r}) would be an input named "
+                                 f"{inp.name!r}, which is one of the twin's own signals ({', '.join(RESERVED_NAMES)}); "
+                                 "rename the link")
 
     rigid_children: dict[str, list[str]] = {}
     for j in joints:
@@ -207,15 +249,61 @@ def load_mechanism(urdf: str | Path, finger_names: tuple[str, ...] | None = None
             todo.extend(rigid_children.get(name, []))
         return group
 
-    candidates = [Finger(j.child, j.name, tuple(rigid_group(j.child))) for j in joints if j.type in MOVABLE]
+    candidates = tuple(Finger(j.child, j.name, tuple(rigid_group(j.child))) for j in joints if j.type in MOVABLE)
     if finger_names is None:
         fingers = tuple(f for f in candidates if any(links[name] for name in f.links))
     else:
-        known = {f.name: f for f in candidates}
-        missing = [n for n in finger_names if n not in known]
-        if missing:
-            raise MechanismError(
-                f"{urdf}: finger {missing[0]!r} is not the child link of a movable joint "
-                f"(movable links: {', '.join(known) or 'none'})")
-        fingers = tuple(known[n] for n in finger_names)
-    return Mechanism(urdf, robot_name, roots[0], tuple(inputs), tuple(mimics), fingers)
+        fingers = _named_fingers(urdf, finger_names, candidates)
+    rigid = tuple((j.name, j.type) for j in joints if j.type in NOT_DRIVEN)
+    return Mechanism(urdf, robot_name, roots[0], tuple(inputs), tuple(mimics), fingers, rigid)
+
+
+def _narrow_for_follower(urdf: Path, follower: _Joint, m: Mimic, ranges: dict[str, tuple[float, float]],
+                         notes: dict[str, list[str]]) -> None:
+    """Narrow the master's range so that the follower stays within its own URDF limits."""
+    if not follower.has_range:
+        return
+    lo, hi = ranges[m.master]
+    if m.multiplier == 0:
+        if not follower.lower <= m.offset <= follower.upper:
+            raise MechanismError(f"{urdf}: mimic joint {m.joint!r} sits at {m.offset:g}, outside its limits "
+                                 f"{follower.lower:g} to {follower.upper:g}")
+        return
+    a, b = sorted(((follower.lower - m.offset) / m.multiplier, (follower.upper - m.offset) / m.multiplier))
+    eps = 1e-9 * max(1.0, abs(lo), abs(hi))  # rounding of the division is no reason to narrow
+    new_lo, new_hi = (a if a > lo + eps else lo), (b if b < hi - eps else hi)
+    if new_lo > new_hi:
+        raise MechanismError(f"{urdf}: mimic joint {m.joint!r} (= {m.multiplier:g} x {m.master} {m.offset:+g}) "
+                             f"cannot stay within its limits {follower.lower:g} to {follower.upper:g} for any value "
+                             f"of {m.master!r} in {lo:g} to {hi:g}")
+    if (new_lo, new_hi) != (lo, hi):
+        ranges[m.master] = (new_lo, new_hi)
+        notes.setdefault(m.master, []).append(
+            f"range narrowed from the URDF's {lo:g} to {hi:g} so that mimic joint {m.joint} stays within "
+            f"its limits {follower.lower:g} to {follower.upper:g}")
+
+
+def _named_fingers(urdf: Path, names: tuple[str, ...], candidates: tuple[Finger, ...]) -> tuple[Finger, ...]:
+    """The fingers a station names: any link of a finger's rigid group stands for that finger."""
+    owner = {}
+    for f in candidates:
+        for link in f.links:
+            owner.setdefault(link, f)
+    fingers: list[Finger] = []
+    for name in names:
+        finger = owner.get(name)
+        if finger is None:
+            known = ", ".join(f.name + (f" (+{', '.join(f.links[1:])})" if len(f.links) > 1 else "")
+                              for f in candidates)
+            raise MechanismError(f"{urdf}: finger {name!r} is not a link of a finger, i.e. a movable joint's child "
+                                 f"link or a link fixed to one (fingers: {known or 'none'})")
+        if finger in fingers:
+            raise MechanismError(f"{urdf}: finger {name!r} is finger {finger.name!r}, which is already named")
+        fingers.append(finger)
+    return tuple(fingers)
+
+
+def read_links_and_joints(urdf: str | Path) -> tuple[tuple[str, ...], dict[str, str]]:
+    """The link names and the joint types (by joint name) of any URDF, e.g. to check a station's robot."""
+    _, links, joints = _parse(Path(urdf))
+    return tuple(links), {j.name: j.type for j in joints}

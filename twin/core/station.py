@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import StationError
+from .errors import MechanismError, StationError
+from .mechanism import MOVABLE, Mechanism, load_mechanism, read_links_and_joints
 
 SHAPES = ("ring", "box", "cylinder", "plane")
 MAX_RING_SEGMENTS = 16
@@ -136,6 +137,14 @@ class Station:
         return self.file.parent
 
 
+_TYPE_NAMES = {float: "number", str: "string", int: "integer", bool: "bool", list: "list", dict: "table"}
+
+
+def _all_numbers(values: list) -> bool:
+    """Every value a finite number (TOML has nan and inf: they would poison the physics)."""
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values)
+
+
 class _Reader:
     """Reads one TOML table, checking types and reporting bad keys with their full path."""
 
@@ -163,8 +172,10 @@ class _Reader:
         if float in kinds and isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         if not isinstance(value, kinds) or (isinstance(value, bool) and bool not in kinds):
-            names = " or ".join(k.__name__ for k in kinds).replace("float", "number").replace("str", "string")
-            raise self.error(name, f"must be a {names}, not {value!r}")
+            names = " or ".join(_TYPE_NAMES.get(k, k.__name__) for k in kinds)
+            raise self.error(name, f"must be {'an' if names[0] in 'aeiou' else 'a'} {names}, not {value!r}")
+        if isinstance(value, float) and not math.isfinite(value):
+            raise self.error(name, f"must be a finite number, not {value!r}")
         if check is not None:
             problem = check(value)
             if problem:
@@ -184,8 +195,8 @@ class _Reader:
         value = self.get(name, list, default)
         if value is default:
             return value
-        if len(value) != n or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
-            raise self.error(name, f"must be a list of {n} numbers, not {value!r}")
+        if len(value) != n or not _all_numbers(value):
+            raise self.error(name, f"must be a list of {n} finite numbers, not {value!r}")
         return tuple(float(v) for v in value)
 
     def sub(self, name: str, required=True) -> "_Reader | None":
@@ -211,6 +222,8 @@ class _Reader:
         path = (self.file.parent / text).resolve()
         if not path.exists():
             raise self.error(name, f"file {text!r} not found (looked at {path})")
+        if not path.is_file():
+            raise self.error(name, f"{text!r} is a folder, not a file (looked at {path})")
         return path
 
     def done(self) -> None:
@@ -270,10 +283,14 @@ def load_station(path: str | Path) -> Station:
     file = path / "station.toml" if path.is_dir() else path
     if not file.exists():
         raise StationError(str(file), "", "no such station file")
+    if file.is_dir():
+        raise StationError(str(file), "", "is a folder, not a station file")
     try:
-        data = tomllib.loads(file.read_text())
+        data = tomllib.loads(file.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise StationError(str(file), "", f"not valid TOML: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise StationError(str(file), "", f"cannot be read: {exc}") from None
     top = _Reader(file.resolve(), data, "")
     file = top.file
 
@@ -294,8 +311,8 @@ def load_station(path: str | Path) -> Station:
             jr.done()
         jt.done()
     fingers = g.get("fingers", list, None)
-    if fingers is not None and not all(isinstance(f, str) for f in fingers):
-        raise g.error("fingers", "must be a list of link names")
+    if fingers is not None and (not fingers or not all(isinstance(f, str) for f in fingers)):
+        raise g.error("fingers", f"must be a list of one or more link names, not {fingers!r}")
     initial_r = g.sub("initial", required=False)
     initial: dict[str, float] = {}
     if initial_r is not None:
@@ -320,13 +337,18 @@ def load_station(path: str | Path) -> Station:
     robot_targets: dict[str, Placement] = {}
     if rr is not None:
         home = rr.get("home_deg", list, [0.0] * 6)
-        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in home):
-            raise rr.error("home_deg", "must be a list of numbers (degrees)")
+        if not _all_numbers(home):
+            raise rr.error("home_deg", f"must be a list of finite numbers (degrees), not {home!r}")
         jn = rr.get("joints", list, list(RobotSpec.joints))
+        if not jn or not all(isinstance(n, str) for n in jn):
+            raise rr.error("joints", f"must be a list of joint names (strings), not {jn!r}")
+        if len(set(jn)) != len(jn):
+            raise rr.error("joints", f"names a joint twice: {jn!r}")
         robot = RobotSpec(rr.path_to("urdf"), _placement_key(rr, "base"), tuple(float(v) for v in home),
                           rr.get("flange_link", str, "flange"), tuple(jn))
         if len(robot.home_deg) != len(robot.joints):
             raise rr.error("home_deg", f"needs one value per joint ({len(robot.joints)}), has {len(robot.home_deg)}")
+        _check_robot_urdf(file, robot, given=rr.has("joints"))
         tr = rr.sub("targets", required=False)
         if tr is not None:
             for tname in list(tr.table):
@@ -366,4 +388,62 @@ def load_station(path: str | Path) -> Station:
         controller = ControllerSpec(cr.path_to("program"), cr.get("entry", str, "main"), tuple(io))
         cr.done()
     top.done()
-    return Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller)
+    station = Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller)
+    gripper_mechanism(station)  # the gripper's URDF and what the station says about it must agree
+    return station
+
+
+def _check_robot_urdf(file: Path, robot: RobotSpec, given: bool) -> None:
+    """The robot's joints and flange must be in its URDF (else pybullet fails later, with no names)."""
+    try:
+        links, joints = read_links_and_joints(robot.urdf)
+    except MechanismError as exc:
+        raise StationError(str(file), "robot.urdf", str(exc)) from None
+    movable = [n for n, t in joints.items() if t in MOVABLE]
+    hint = "" if given else f" (the default is {', '.join(RobotSpec.joints)}; name the arm's joints with robot.joints)"
+    for n in robot.joints:
+        if n not in joints:
+            raise StationError(str(file), "robot.joints", f"{robot.urdf.name} has no joint {n!r}{hint}; "
+                                                          f"its movable joints: {', '.join(movable) or 'none'}")
+        if joints[n] not in MOVABLE:
+            raise StationError(str(file), "robot.joints", f"joint {n!r} of {robot.urdf.name} is {joints[n]}, not movable")
+    extra = [n for n in movable if n not in robot.joints]
+    if extra:
+        raise StationError(str(file), "robot.joints", f"{robot.urdf.name} has movable joints that are not named here: "
+                                                      f"{', '.join(extra)} (the arm's joints must be all of them)")
+    if robot.flange_link not in links:
+        raise StationError(str(file), "robot.flange_link", f"{robot.urdf.name} has no link {robot.flange_link!r} "
+                                                           f"(its links: {', '.join(links)})")
+
+
+def gripper_mechanism(station: Station) -> Mechanism:
+    """The station's gripper mechanism, checked against the station (initial values, overrides, fingers).
+
+    Every problem is a StationError naming the station file and the key, so it reads as a station mistake.
+    """
+    g, file = station.gripper, str(station.file)
+    try:
+        mech = load_mechanism(g.urdf)
+    except MechanismError as exc:
+        raise StationError(file, "gripper.urdf", str(exc)) from None
+    if g.fingers is not None:
+        try:
+            mech = load_mechanism(g.urdf, g.fingers)
+        except MechanismError as exc:
+            raise StationError(file, "gripper.fingers", str(exc)) from None
+    elif not mech.fingers:
+        raise StationError(file, "gripper.urdf", f"{g.urdf.name} has no finger: no movable link (with the links fixed "
+                                                 "to it) has collision geometry, so nothing could ever grip; name the "
+                                                 "fingers with gripper.fingers")
+    names = [i.name for i in mech.inputs]
+    for key, table in (("initial", g.initial), ("joints", g.joints)):
+        for name in table:
+            if name not in names:
+                raise StationError(file, f"gripper.{key}.{name}", f"{g.urdf.name} has no input {name!r} "
+                                                                  f"(its inputs: {', '.join(names)})")
+    for name, value in g.initial.items():
+        inp = mech.input(name)
+        if not inp.min <= value <= inp.max:
+            raise StationError(file, f"gripper.initial.{name}", f"{value:g} {inp.unit} is outside the input's range "
+                                                                f"{inp.min:g} to {inp.max:g} {inp.unit}")
+    return mech

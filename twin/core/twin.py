@@ -15,12 +15,12 @@ from pathlib import Path
 import pybullet
 from typing import Protocol
 
-from .errors import MotionError, SignalError
+from .errors import MotionError, SignalError, StationError
 from .gripper import IN_POSITION_TOLERANCE, MOVING_SPEED, Gripper
 from .mechanism import Mechanism, load_mechanism
 from .signals import BOOL, ENUM, FLOAT, INPUT, OUTPUT, SignalSpec
 from .station import Station, load_station
-from .world import ROBOT_PREFIX, World
+from .world import ROBOT_PREFIX, World, quat
 
 FORCE_UNIT = {"m": "N", "rad": "N*m"}
 
@@ -91,9 +91,16 @@ class Twin:
             from .kinematics import ArmKinematics
             from .robot import Robot
 
-            base_pos, base_orn = self.world.client.getBasePositionAndOrientation(self.world.machine)
+            # The station's base pose is the URDF base frame, where the world loaded the arm; pybullet's
+            # getBasePositionAndOrientation would give the base link's centre of mass instead.
+            base = Pose(st.robot.base.xyz, quat(st.robot.base))  # the very quaternion the world used
             tool = Pose.from_xyz_rpy(st.gripper.tcp.xyz, st.gripper.tcp.rpy)
-            self.kinematics = ArmKinematics(st.robot.urdf, base_pos, base_orn, flange_link=st.robot.flange_link, tool=tool)
+            try:
+                self.kinematics = ArmKinematics(st.robot.urdf, base.position, base.orientation,
+                                                flange_link=st.robot.flange_link, tool=tool,
+                                                joint_names=st.robot.joints)
+            except MotionError as exc:  # load_station checks names; what is left is the joints' order
+                raise StationError(str(st.file), "robot.joints", str(exc).split(": ", 1)[-1]) from None
             self.robot = Robot(self.world.client, self.world.machine,
                                tuple(ROBOT_PREFIX + j for j in st.robot.joints), self.kinematics)
             self.robot.reset([math.radians(a) for a in st.robot.home_deg])
@@ -146,7 +153,7 @@ class Twin:
                           + (" (this station's gripper is always active)" if st.gripper.always_active else ""))]
         for inp in m.inputs:
             sig.append(SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max,
-                                  f"setpoint of {inp.type} joint {inp.joint}"))
+                                  f"setpoint of {inp.type} joint {inp.joint}" + (f" ({inp.note})" if inp.note else "")))
         sig.append(SignalSpec("doGripped", OUTPUT, BOOL, description="every finger touches the same target: it is held"))
         sig.append(SignalSpec("GrippedPart", OUTPUT, ENUM, description="the held target (none, or one of the target group)",
                               choices=("",) + targets))
@@ -173,6 +180,12 @@ class Twin:
             for axis in "xyz":
                 sig.append(SignalSpec(f"{t.name}.{axis}", OUTPUT, FLOAT, "m", group="cell",
                                       description=f"{axis} of {t.name}'s centre in the world frame"))
+        seen: dict[str, SignalSpec] = {}
+        for spec in sig:  # link and target names are free text: two of them may make the same signal name
+            if spec.name in seen:
+                raise StationError(str(st.file), "gripper.urdf", f"two signals would be named {spec.name!r} "
+                                   f"({seen[spec.name].description}; {spec.description}): rename a link or target")
+            seen[spec.name] = spec
         return tuple(sig)
 
     def _joint_unit(self, joint: str) -> str:

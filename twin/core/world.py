@@ -7,7 +7,9 @@ from scratch rather than restored from a snapshot: `restoreState` is not exact o
 
 The gripper URDF is merged into the robot URDF under the flange link, so arm and gripper are one
 multibody: the gripper moves with the flange with no soft constraint in between. Robot link and joint
-names get the prefix `robot/` so they cannot clash with the gripper's.
+names get the prefix `robot/` so they cannot clash with the gripper's. Either way the world loads a
+rewritten copy of the URDFs: mesh paths made absolute (`package://` resolved as ROS tools do) and
+planar, floating and spherical gripper joints made fixed, as the mechanism treats them.
 """
 from __future__ import annotations
 
@@ -22,6 +24,8 @@ from pathlib import Path
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
+from .errors import StationError
+from .mechanism import NOT_DRIVEN
 from .station import Body, Placement, Station
 
 ROBOT_PREFIX = "robot/"
@@ -64,24 +68,84 @@ def quat(p: Placement) -> tuple[float, float, float, float]:
     return tuple(pybullet.getQuaternionFromEuler(p.rpy))  # type: ignore[return-value]
 
 
-def _absolutize_meshes(root: ET.Element, folder: Path) -> None:
+MESH_TAGS = ("mesh", "texture")  # the URDF elements whose `filename` is a file to load
+
+
+def resolve_package_path(fname: str, folder: Path) -> tuple[Path | None, list[Path]]:
+    """Where a mesh path of a URDF in `folder` points, as ROS tools resolve it; and the places tried.
+
+    `package://PKG/rest` is looked up in the nearest folder upwards that is named PKG or holds a folder
+    PKG (a ROS package or a workspace), then in the URDF's folder and its parent (URDFs copied out of
+    their package, such as pybullet_data's). A relative path is relative to the URDF's folder.
+    """
+    if fname.startswith("file://"):
+        fname = fname[len("file://"):]
+    if not fname.startswith("package://"):
+        path = Path(fname) if Path(fname).is_absolute() else (folder / fname)
+        return (path.resolve() if path.is_file() else None), [path]
+    pkg, _, rest = fname[len("package://"):].partition("/")
+    tried: list[Path] = []
+    if rest:
+        for d in (folder, *folder.parents):
+            for base in ((d,) if d.name == pkg else ()) + (d / pkg,):
+                tried.append(base / rest)
+                if tried[-1].is_file():
+                    return tried[-1].resolve(), tried
+    rest = rest or pkg
+    for base in (folder, folder.parent):
+        tried.append(base / rest)
+        if tried[-1].is_file():
+            return tried[-1].resolve(), tried
+    return None, tried
+
+
+def _absolutize_meshes(root: ET.Element, urdf: Path, file: Path, key: str) -> None:
+    """Make every mesh path absolute, so the URDF can be written anywhere; a missing mesh is a StationError."""
+    folder = urdf.parent
     for elem in root.iter():
         fname = elem.get("filename")
-        if fname is None:
+        if fname is None or elem.tag not in MESH_TAGS:
             continue
-        if fname.startswith("package://"):
-            fname = fname[len("package://"):].split("/", 1)[-1]
-        if not Path(fname).is_absolute():
-            elem.set("filename", str((folder / fname).resolve()))
+        path, tried = resolve_package_path(fname, folder)
+        if path is None:
+            looked = ", ".join(os.path.normpath(p) for p in tried[:4]) + (", ..." if len(tried) > 4 else "")
+            raise StationError(str(file), key, f"{urdf}: mesh {fname!r} not found (looked at {looked})")
+        elem.set("filename", str(path))
+
+
+def _rigid_for_pybullet(root: ET.Element) -> None:
+    """Planar, floating and spherical joints are no inputs: make them fixed, as the mechanism treats them."""
+    for joint in root.findall("joint"):
+        if joint.get("type") in NOT_DRIVEN:
+            joint.set("type", "fixed")
+
+
+def _read(urdf: Path, file: Path, key: str) -> ET.Element:
+    try:
+        return ET.parse(urdf).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise StationError(str(file), key, f"{urdf}: cannot be read as a URDF: {exc}") from None
+
+
+def write_gripper(gripper_urdf: Path, file: Path, out_dir: Path) -> Path:
+    """The gripper's URDF as the world loads it when there is no robot: absolute mesh paths, rigid joints."""
+    gripper = _read(gripper_urdf, file, "gripper.urdf")
+    _absolutize_meshes(gripper, gripper_urdf, file, "gripper.urdf")
+    _rigid_for_pybullet(gripper)
+    out = out_dir / "gripper.urdf"
+    ET.ElementTree(gripper).write(out)
+    return out
 
 
 def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper_urdf: Path, gripper_root: str,
-                             mount: Placement, out_dir: Path) -> Path:
+                             mount: Placement, out_dir: Path, file: Path | str = "station") -> Path:
     """Write one URDF where the gripper's root link hangs off the robot's flange by a fixed joint."""
-    robot = ET.parse(robot_urdf).getroot()
-    gripper = ET.parse(gripper_urdf).getroot()
-    _absolutize_meshes(robot, robot_urdf.parent)
-    _absolutize_meshes(gripper, gripper_urdf.parent)
+    file = Path(file)
+    robot = _read(robot_urdf, file, "robot.urdf")
+    gripper = _read(gripper_urdf, file, "gripper.urdf")
+    _absolutize_meshes(robot, robot_urdf, file, "robot.urdf")
+    _absolutize_meshes(gripper, gripper_urdf, file, "gripper.urdf")
+    _rigid_for_pybullet(gripper)
     for elem in robot:
         if elem.tag in ("link", "joint"):
             elem.set("name", ROBOT_PREFIX + elem.get("name", ""))
@@ -124,11 +188,15 @@ class World:
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE
         if station.robot is not None:
             urdf = merge_gripper_into_robot(station.robot.urdf, station.robot.flange_link, station.gripper.urdf,
-                                            gripper_root, station.gripper.mount, Path(self._tmp.name))
-            base = station.robot.base
+                                            gripper_root, station.gripper.mount, Path(self._tmp.name), station.file)
+            base, key, source = station.robot.base, "robot.urdf", f"{station.robot.urdf} with the gripper"
         else:
-            urdf, base = station.gripper.urdf, station.gripper.mount
-        self.machine = self.client.loadURDF(str(urdf), base.xyz, quat(base), useFixedBase=True, flags=flags)
+            urdf = write_gripper(station.gripper.urdf, station.file, Path(self._tmp.name))
+            base, key, source = station.gripper.mount, "gripper.urdf", str(station.gripper.urdf)
+        try:
+            self.machine = self.client.loadURDF(str(urdf), base.xyz, quat(base), useFixedBase=True, flags=flags)
+        except pybullet.error as exc:  # pybullet says only "Cannot load URDF file."; name what was loaded
+            raise StationError(str(station.file), key, f"pybullet cannot load {source}: {exc}") from None
         self.joint_index: dict[str, int] = {}
         self.link_index: dict[str, int] = {self.client.getBodyInfo(self.machine)[0].decode(): -1}
         for j in range(self.client.getNumJoints(self.machine)):
@@ -179,6 +247,7 @@ class World:
         self.client.stepSimulation()
 
     def pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+        """A target's or fixture's frame (built here with no inertial offset, so its centre of mass is its frame)."""
         pos, orn = self.client.getBasePositionAndOrientation(self.body_ids[name])
         return tuple(pos), tuple(orn)
 
