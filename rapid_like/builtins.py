@@ -113,7 +113,7 @@ _INSTRUCTIONS = {
     "WaitDO": r"signaldo Signal, num Value, \num MaxTime, \INOUT bool TimeFlag",
     "WaitUntil": r"\switch InPos, bool Cond, \num MaxTime, \INOUT bool TimeFlag, \num PollRate",
     "WaitRob": r"\switch InPos, \switch ZeroSpeed",
-    "TPWrite": r"string String, \num Num, \bool Bool, \pos Pos, \orient Orient",
+    "TPWrite": r"string String, \num Num | bool Bool | pos Pos | orient Orient",
     "TPErase": "",
     "MoveJ": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
     "MoveL": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
@@ -201,8 +201,9 @@ def match_args(params: list[Param], args: list[Arg]) -> tuple[dict[str, Arg], st
                     group = [q] + q.alternatives
             for other in group:
                 if other.key in bound:
-                    return bound, f"\\{a.name} and \\{other.name} exclude each other", a
-            if p.type == "switch" and a.value is not None:
+                    choices = " | ".join("\\" + q.name for q in group)
+                    return bound, f"\\{a.name} and \\{other.name} exclude each other (give one of {choices})", a
+            if p.type == "switch" and a.value is not None and not a.conditional:
                 return bound, f"\\{a.name} is a switch and takes no value", a
             if p.type != "switch" and a.value is None:
                 return bound, f"\\{a.name} needs a value (\\{a.name}:=...)", a
@@ -269,6 +270,48 @@ def qrotate(q: list[float], v: list[float]) -> list[float]:
 def _clean(x: float) -> float:
     r = round(x, 9)
     return 0.0 if r == 0 else r
+
+
+# ---- poses: (trans [x, y, z] in mm, quaternion [q1, q2, q3, q4] with q1 = w) --------------------------
+Pose = tuple[list[float], list[float]]
+
+
+def pose_of(p: Record) -> Pose:
+    """The trans and rot of a robtarget or pose record."""
+    t, r = p.fields["trans"].fields, p.fields["rot"].fields  # type: ignore[union-attr]
+    return [t["x"], t["y"], t["z"]], [r["q1"], r["q2"], r["q3"], r["q4"]]  # type: ignore[list-item]
+
+
+def _unit(q: list[float]) -> list[float]:
+    norm = math.sqrt(sum(c * c for c in q)) or 1.0
+    return [c / norm for c in q]
+
+
+def pose_mul(a: Pose, b: Pose) -> Pose:
+    """a * b: the pose b (given in frame a) in a's reference frame."""
+    ta, qa = a
+    tb, qb = b
+    d = qrotate(qa, tb)
+    return [ta[0] + d[0], ta[1] + d[1], ta[2] + d[2]], _unit(qmul(_unit(qa), _unit(qb)))
+
+
+def pose_inv(a: Pose) -> Pose:
+    t, q = a
+    w, x, y, z = _unit(q)
+    qi = [w, -x, -y, -z]
+    d = qrotate(qi, t)
+    return [-d[0], -d[1], -d[2]], qi
+
+
+def wobj_frame(wobj: Record) -> Pose:
+    """A work object's object frame in the world: uframe * oframe (a robot-held or
+    mechanically coupled user frame is taken as fixed)."""
+    return pose_mul(pose_of(wobj.fields["uframe"]), pose_of(wobj.fields["oframe"]))  # type: ignore[arg-type]
+
+
+def tool_frame(tool: Record) -> Pose:
+    """A tool's TCP in the flange frame (its tframe)."""
+    return pose_of(tool.fields["tframe"])  # type: ignore[arg-type]
 
 
 def offs(p: Record, dx: float, dy: float, dz: float) -> Record:

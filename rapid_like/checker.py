@@ -16,7 +16,7 @@ from . import builtins as B
 from . import nodes as n
 from .errors import CheckError, Span
 from .host import SignalInfo
-from .values import KNOWN_TYPES, RECORDS, SIGNAL_TYPES, array_type, base_type, split_array_type
+from .values import KNOWN_TYPES, RECORDS, SIGNAL_TYPES, a_, array_type, base_type, split_array_type
 
 
 @dataclass
@@ -26,6 +26,7 @@ class Sym:
     storage: str = "VAR"  # VAR, PERS, CONST
     signal: SignalInfo | None = None
     name: str = ""  # as declared
+    optional: bool = False  # an optional parameter (\\Name) of the routine
 
 
 def check(module: n.Module, signals: dict[str, SignalInfo] | None = None) -> None:
@@ -134,9 +135,11 @@ class Checker:
                     raise self.err(f"parameter {q.name} is declared twice", q.span)
                 kind = "switch" if q.type == "switch" else "param"
                 if q.type in SIGNAL_TYPES:
-                    scope[q.key] = Sym("signal", "num", "CONST", SignalInfo(q.name, SIGNAL_TYPES[q.type]))
+                    scope[q.key] = Sym("signal", "num", "CONST", SignalInfo(q.name, SIGNAL_TYPES[q.type]),
+                                       optional=q.optional)
                 else:
-                    scope[q.key] = Sym(kind, q.type, "CONST" if kind == "switch" else "VAR", name=q.name)
+                    scope[q.key] = Sym(kind, q.type, "CONST" if kind == "switch" else "VAR", name=q.name,
+                                       optional=q.optional)
         self.current = r
         self.labels: list[dict[str, n.Label]] = []
         self.all_labels = {lab.name.lower() for lab in _walk_labels(r.body)}
@@ -208,7 +211,7 @@ class Checker:
                 raise self.err(f"a PROC returns no value: write RETURN; in {r.name}", s.value.span)
             if r.kind == "FUNC":
                 if s.value is None:
-                    raise self.err(f"RETURN in FUNC {r.name} needs a {r.return_type} value", s.span)
+                    raise self.err(f"RETURN in FUNC {r.name} needs {a_(r.return_type)} value", s.span)
                 self.expect_type(s.value, r.return_type, scope)
         elif isinstance(s, (n.Retry, n.TryNext)):
             if not h:
@@ -243,7 +246,7 @@ class Checker:
         if sym.kind == "signal":
             kind = sym.signal.kind if sym.signal else "signal"
             hint = {"DO": "SetDO", "AO": "SetAO", "GO": "SetGO"}.get(kind)
-            raise self.err(f"{root.name} is a {kind} signal and cannot be assigned"
+            raise self.err(f"{root.name} is {a_(kind)} signal and cannot be assigned"
                            + (f": use {hint} {root.name}, value;" if hint else ""), root.span)
         if sym.storage == "CONST":
             what = "the FOR loop variable" if sym.kind == "loop" else "the constant"
@@ -287,13 +290,16 @@ class Checker:
             p = every[key]
             if a.value is None:
                 continue
+            if a.conditional:
+                self.conditional_arg(name, p, a, scope)
+                continue
             if p.type in SIGNAL_TYPES:
                 self.signal_arg(name, p, a.value, scope)
             elif p.type == "any":
                 if name.lower() == "dim":
                     t = self.value_type(a.value, scope)
                     if t is not None and not split_array_type(t):
-                        raise self.err(f"Dim needs an array, {a.value.text} is a {t}", a.value.span)
+                        raise self.err(f"Dim needs an array, {a.value.text} is {a_(t)}", a.value.span)
                 elif name.lower() == "present":
                     if not (isinstance(a.value, n.Name) and self.lookup(a.value.name, scope)
                             and self.lookup(a.value.name, scope).kind in ("param", "switch", "signal")
@@ -307,23 +313,47 @@ class Checker:
                     raise self.err(f"{name}: argument {p.name} must be a variable (it is {p.mode})", a.value.span)
                 t = self.assign_target(a.value, scope)
                 if t is not None and base_type(t) != base_type(p.type):
-                    raise self.err(f"type mismatch: {name} argument {p.name} must be a {p.type} variable, "
+                    raise self.err(f"type mismatch: {name} argument {p.name} must be {a_(p.type)} variable, "
                                    f"{a.value.text} is {t}", a.value.span)
             else:
                 self.expect_type(a.value, p.type, scope, what=f"{name} argument {p.name}")
 
+    def conditional_arg(self, name: str, p: n.Param, a: n.Arg, scope: dict[str, Sym]) -> None:
+        """`\\Name?Param`: Param must be an optional parameter of the calling routine, of the type
+        that Name takes (any optional parameter for a switch: its presence is passed on)."""
+        assert isinstance(a.value, n.Name)
+        ref = a.value
+        sym = scope.get(ref.key)
+        what = f"{name}: \\{a.name}?{ref.name}"
+        if sym is None or not sym.optional:
+            if sym is None and self.lookup(ref.name, scope) is None:
+                raise self.undefined(ref.name, ref.span, scope)
+            raise self.err(f"{what}: a conditional argument passes on an optional parameter of "
+                           f"{self.current.name}, and {ref.name} is not one", ref.span)
+        if p.type == "switch":
+            return
+        if sym.kind == "switch":
+            raise self.err(f"{what}: {ref.name} is a switch, {name}'s \\{p.name} takes {a_(p.type)}", ref.span)
+        if p.type in SIGNAL_TYPES:
+            if sym.kind != "signal" or sym.signal is None or sym.signal.kind != SIGNAL_TYPES[p.type]:
+                raise self.err(f"{what}: {name}'s \\{p.name} takes {a_(SIGNAL_TYPES[p.type])} signal", ref.span)
+            return
+        if sym.type is not None and p.type != "any" and base_type(sym.type) != base_type(p.type):
+            raise self.err(f"type mismatch: {what}: \\{p.name} takes {a_(p.type)}, {ref.name} is {a_(sym.type)}",
+                           ref.span)
+
     def signal_arg(self, name: str, p: n.Param, e: n.Expr, scope: dict[str, Sym]) -> None:
         want = SIGNAL_TYPES[p.type]
         if not isinstance(e, n.Name):
-            raise self.err(f"{name}: argument {p.name} must be a {want} signal, found {e.text}", e.span)
+            raise self.err(f"{name}: argument {p.name} must be {a_(want)} signal, found {e.text}", e.span)
         sym = self.lookup(e.name, scope)
         if sym is None:
             raise self.undefined(e.name, e.span, scope)
         if sym.kind != "signal" or sym.signal is None:
-            raise self.err(f"{name}: argument {p.name} must be a {want} signal, {e.name} is "
+            raise self.err(f"{name}: argument {p.name} must be {a_(want)} signal, {e.name} is "
                            f"{sym.type} data", e.span)
         if sym.signal.kind != want:
-            raise self.err(f"{name}: {e.name} is a {sym.signal.kind} signal, {name} needs a {want}", e.span)
+            raise self.err(f"{name}: {e.name} is {a_(sym.signal.kind)} signal, {name} needs {a_(want)}", e.span)
 
     # ---- expressions ---------------------------------------------------------------------------
     def expect_type(self, e: n.Expr, want: str | None, scope: dict[str, Sym], what: str = "") -> None:
@@ -352,7 +382,7 @@ class Checker:
             assert isinstance(e, n.Aggregate)
             spec = RECORDS[want]
             if len(spec) != len(e.items):
-                raise self.err(f"type mismatch: a {want} has {len(spec)} components "
+                raise self.err(f"type mismatch: {a_(want)} has {len(spec)} components "
                                f"({', '.join(f for f, _ in spec)}), the aggregate has {len(e.items)}", e.span)
             for (fname, ftype), item in zip(spec, e.items):
                 it = self.value_type(item, scope) if not isinstance(item, n.Aggregate) else "aggregate"
@@ -397,7 +427,7 @@ class Checker:
                 return None
             arr = split_array_type(t)
             if not arr:
-                raise self.err(f"{e.obj.text} is a {t}, not an array: it cannot be indexed", e.indices[0].span)
+                raise self.err(f"{e.obj.text} is {a_(t)}, not an array: it cannot be indexed", e.indices[0].span)
             elem, ndims = arr
             if len(e.indices) != ndims:
                 raise self.err(f"{e.obj.text} has {ndims} dimension{'s' if ndims > 1 else ''}, "
@@ -413,11 +443,11 @@ class Checker:
                 raise self.err(f"{e.obj.text} is an array: index it first, e.g. {e.obj.text}{{1}}.{e.field}",
                                e.field_span)
             if t not in RECORDS:
-                raise self.err(f"{e.obj.text} is a {t} and has no components", e.field_span)
+                raise self.err(f"{e.obj.text} is {a_(t)} and has no components", e.field_span)
             for fname, ftype in RECORDS[t]:
                 if fname == e.field.lower():
                     return ftype
-            raise self.err(f"a {t} has no component '{e.field}' (it has "
+            raise self.err(f"{a_(t)} has no component '{e.field}' (it has "
                            f"{', '.join(f for f, _ in RECORDS[t])})", e.field_span)
         if isinstance(e, n.Unary):
             t = self.value_type(e.operand, scope)

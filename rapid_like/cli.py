@@ -1,7 +1,7 @@
 """`rapid`: run or check a RAPID program offline.
 
     rapid run PROGRAM.mod [--entry NAME] [--io TYPE:NAME,...]... [--set NAME=VALUE[@T]]...
-                          [--max-time T] [--step S] [--trace]
+                          [--max-time T] [--step S] [--loop-budget N] [--trace]
     rapid check PROGRAM.mod [--io TYPE:NAME,...]...
 
 `--io` plays the controller's I/O configuration (types DI, DO, AI, AO, GI, GO). Without --trace,
@@ -18,7 +18,7 @@ import json
 import sys
 from pathlib import Path
 
-from .controller import read_source
+from .controller import DEFAULT_LOOP_BUDGET, read_source
 from .errors import RapidError
 from .host import SIGNAL_KINDS, SignalInfo
 from .offline import DEFAULT_TIME_LIMIT, SignalChange, run_offline
@@ -98,7 +98,11 @@ def build_parser() -> argparse.ArgumentParser:
                           f"still running at {DEFAULT_TIME_LIMIT:g} s ends there, and one that waits for "
                           "a signal nothing changes is an error)")
     run.add_argument("--step", type=float, default=0.012, metavar="S",
-                     help="simulated time of a loop iteration that waits for nothing (default 0.012)")
+                     help="the controller's tick: a loop that used up its loop budget goes on S seconds "
+                          "later, or earlier at a --set change or a pulse edge (default 0.012)")
+    run.add_argument("--loop-budget", type=int, default=DEFAULT_LOOP_BUDGET, metavar="N",
+                     help="loop iterations that consume no time run per tick before the loop waits for "
+                          f"the next tick (default {DEFAULT_LOOP_BUDGET})")
     run.add_argument("--trace", action="store_true", help="print every event as one JSON object per line")
     return p
 
@@ -132,6 +136,8 @@ def main(argv: list[str] | None = None) -> int:
                 raise UsageError("--max-time must be >= 0")
             if args.step <= 0:
                 raise UsageError("--step must be > 0")
+            if args.loop_budget < 1:
+                raise UsageError("--loop-budget must be >= 1")
     except UsageError as e:
         print(f"rapid: error: {e}", file=err)
         return EX_USAGE
@@ -158,7 +164,8 @@ def main(argv: list[str] | None = None) -> int:
             elif ev["type"] == "print":
                 out.write(ev["text"] + "\n")
 
-        outcome = run_offline(module, signals, changes, args.entry, args.max_time, args.step, on_event)
+        outcome = run_offline(module, signals, changes, args.entry, args.max_time, args.step, on_event,
+                              loop_budget=args.loop_budget)
     except RapidError as e:
         report(e)
         return EX_DATAERR

@@ -1,14 +1,17 @@
 """The robot controller: a checked RAPID program, a Host, and a tick that whoever owns simulated
 time calls once per step. No threads, no sleeps, no wall clock.
 
-    ctl = Controller(module, host, entry="main", on_event=print, step=None)
+    ctl = Controller(module, host, entry="main", on_event=print, step=None, loop_budget=10_000)
     while ...:
         ctl.tick(now)          # simulated seconds; runs statements until the program must wait
 
 `tick(now)` first writes the PulseDO edges that are due, then runs the program until it waits
-(WaitTime, WaitUntil, WaitDI/WaitDO, a motion the host has not finished, Stop) or ends. A loop
-iteration that consumed no time also waits for the next tick, so a busy `WHILE` never hangs the
-cell. Time is kept in integer nanoseconds, so five `WaitTime 0.2` end at exactly 1.0 s.
+(WaitTime, WaitUntil, WaitDI/WaitDO, a motion the host has not finished, Stop) or ends. Loop
+iterations that consume no time run on at the same instant until the tick's `loop_budget` of them
+is used up (10 000 by default); then the loop waits for the next tick, at which it is always ready
+to go on. So a `FOR` that sums 1000 numbers ends at the instant it started, and a busy `WHILE`
+never hangs the cell. Time is kept in integer nanoseconds, so five `WaitTime 0.2` end at exactly
+1.0 s.
 
 State: `state` is "running", "waiting", "stopped", "completed" or "error" (`error` holds the
 ExecError); `end_reason` is "completed", "exit" or "stop" once the program has ended or stopped.
@@ -38,6 +41,7 @@ from .interpreter import NS, ExitSignal, Fatal, Interpreter, Propagate, Wait, to
 from .parser import parse
 
 RUNNING, WAITING, STOPPED, COMPLETED, ERROR = "running", "waiting", "stopped", "completed", "error"
+DEFAULT_LOOP_BUDGET = 10_000  # time-less loop iterations per tick
 
 
 def read_source(path: str | Path) -> str:
@@ -57,9 +61,12 @@ def load_program(path: str | Path) -> n.Module:
 class Controller:
     def __init__(self, program: n.Module, host: Host, entry: str = "main",
                  on_event: Callable[[dict], None] | None = None, step: float | None = None,
-                 autostart: bool = True):
-        """`step`: when set, a time-less loop iteration resumes `step` seconds later (event-driven
-        runners); when None it resumes at the next tick (a binding ticking at a fixed rate)."""
+                 autostart: bool = True, loop_budget: int = DEFAULT_LOOP_BUDGET):
+        """`loop_budget`: how many loop iterations that consume no time the program may run in one
+        tick before it hands control back (until the next tick). `step`: for event-driven runners,
+        the time of the next tick after a loop used up its budget (`next_wake_ns` reports it); the
+        loop goes on at whichever tick comes first. With None (a binding ticking at a fixed rate)
+        it goes on at the next tick."""
         self.program = program
         self.host = host
         self.on_event = on_event
@@ -73,7 +80,7 @@ class Controller:
         if routine.kind != "PROC" or any(not p.optional for p in routine.params):
             raise CheckError(f"the entry routine {routine.name} must be a PROC without parameters", routine.span)
         self.entry = routine.name
-        self.interp = Interpreter(program, host, self._emit)
+        self.interp = Interpreter(program, host, self._emit, loop_budget=loop_budget)
         self.now = 0
         self.state = STOPPED
         self.end_reason: str | None = None
@@ -145,7 +152,7 @@ class Controller:
         if w.kind in ("time", "poll"):
             return self.now >= (w.at or 0)
         if w.kind == "step":
-            return w.at is None or self.now >= w.at
+            return True  # a loop that used up its budget goes on at the next tick, whenever it comes
         if w.kind == "stop":
             return False
         return True  # signal, motion: re-evaluate on every tick
@@ -160,6 +167,7 @@ class Controller:
                 self.state = WAITING
                 self.interp.suspensions += 1
                 return
+            self.interp.spins = 0  # a new tick: a new loop budget
             while True:
                 self.wait = None
                 w = next(self._gen)

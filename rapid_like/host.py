@@ -16,6 +16,15 @@ Names passed to read/write are the configured spelling. Values are RAPID nums (d
 in the controller's unit, e.g. mm). `InMemoryHost` is the offline host: signals live in a dict and a
 motion is complete as soon as it starts (the robot is at its target at once).
 
+CRobT (`current_robtarget(tool, wobj)`): the TCP of `tool` in `wobj`; as in RAPID, an omitted
+\\Tool or \\WObj (None) means the one that is active, i.e. the tool and work object of the last
+motion instruction (tool0 and wobj0 before the first one). Offline, the flange pose is kept from
+the last MoveJ/MoveL/MoveC as `wobj frame * target * inverse(tool.tframe)`, so CRobT with the
+active tool and wobj returns that target exactly as written and any other tool or wobj sees the
+same flange through its own frames. A MoveAbsJ has no kinematics offline: it makes its tool and
+wobj the active ones but leaves the flange where the last Cartesian motion put it (CJointT reports
+its joints).
+
 Notes for a station binding (item 5):
 - `signals()` comes from the station file's controller I/O section (name, type, wiring). The
   controller reads outputs too (`aoAxis1<=440` reads the AO's present value), so `read_signal`
@@ -35,6 +44,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Protocol, Sequence, runtime_checkable
 
+from .builtins import pose_inv, pose_mul, pose_of, predefined_data, tool_frame, wobj_frame
 from .values import Record, default_value, record
 
 SIGNAL_KINDS = ("DI", "DO", "AI", "AO", "GI", "GO")
@@ -104,12 +114,18 @@ class InMemoryHost:
     values: dict[str, float] = field(default_factory=dict)
     printed: list[str] = field(default_factory=list)
     moves: list[MotionRequest] = field(default_factory=list)
-    position: Record = field(default_factory=lambda: record("robtarget", *HOME_ROBTARGET))
+    position: Record = field(default_factory=lambda: record("robtarget", *HOME_ROBTARGET))  # last target
     joints: Record = field(default_factory=lambda: default_value("jointtarget"))  # type: ignore[assignment]
+    tool: Record = field(default_factory=lambda: predefined_data()["tool0"][1])  # type: ignore[assignment]
+    wobj: Record = field(default_factory=lambda: predefined_data()["wobj0"][1])  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         for s in self.config:
             self.values.setdefault(s.name, 0.0)
+        # the flange in the world, and the (tool, wobj) for which CRobT returns `position` as written
+        self.flange = pose_mul(pose_mul(wobj_frame(self.wobj), pose_of(self.position)),
+                               pose_inv(tool_frame(self.tool)))
+        self.active = (self.tool.copy(), self.wobj.copy())
 
     def signals(self) -> Sequence[SignalInfo]:
         return self.config
@@ -130,16 +146,34 @@ class InMemoryHost:
             self.joints = request.target.copy()
         else:
             self.position = request.target.copy()
+            self.flange = pose_mul(pose_mul(wobj_frame(request.wobj), pose_of(request.target)),
+                                   pose_inv(tool_frame(request.tool)))
+            self.active = (request.tool.copy(), request.wobj.copy())
+        self.tool, self.wobj = request.tool.copy(), request.wobj.copy()  # the active tool and wobj
         return len(self.moves)
 
     def motion_done(self, handle: object) -> bool:
         return True
 
     def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
-        return self.position.copy()
+        tool = tool or self.tool
+        wobj = wobj or self.wobj
+        out = self.position.copy()
+        if tool == self.active[0] and wobj == self.active[1]:
+            return out  # the last Cartesian target, as written
+        trans, rot = pose_mul(pose_mul(pose_inv(wobj_frame(wobj)), self.flange), tool_frame(tool))
+        t, r = out.fields["trans"].fields, out.fields["rot"].fields  # type: ignore[union-attr]
+        t["x"], t["y"], t["z"] = (_clean(v) for v in trans)
+        r["q1"], r["q2"], r["q3"], r["q4"] = (_clean(v) for v in rot)
+        return out
 
     def current_jointtarget(self) -> Record:
         return self.joints.copy()
 
     def tp_write(self, text: str) -> None:
         self.printed.append(text)
+
+
+def _clean(x: float) -> float:
+    r = round(x, 9)
+    return 0.0 if r == 0 else r

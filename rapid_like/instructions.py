@@ -28,10 +28,8 @@ class InstructionsMixin:
         if key not in B.FUNCTIONS:
             raise self.fail(f"unknown function '{e.name}'", e.span)
         params, rtype = B.FUNCTIONS[key]
-        bound, msg, bad = B.match_args(params, e.args)
-        if msg:
-            raise self.fail(f"{e.name}: {msg}", bad.span if bad else e.span)
-        ptypes = {p.key: p.type for p in params}
+        bound = self.match(e.name, params, e.args, f, e.span)
+        ptypes = {q.key: q.type for p in params for q in (p, *p.alternatives)}
 
         def arg(name: str, default: object = None) -> object:
             a = bound.get(name)
@@ -117,6 +115,7 @@ class InstructionsMixin:
             if key == "dist":
                 return B.dist(vals[0], vals[1])
             if key == "clkread":
+                self.changes += 1  # depends on the time
                 return x.read(self.now)
             if key == "dim":
                 sizes = x.sizes() if isinstance(x, list) and hasattr(x, "sizes") else []
@@ -135,10 +134,8 @@ class InstructionsMixin:
         if key not in B.INSTRUCTIONS:
             raise self.fail(f"unknown instruction or procedure '{s.name}'", s.span)
         params = B.INSTRUCTIONS[key]
-        bound, msg, bad = B.match_args(params, s.args)
-        if msg:
-            raise self.fail(f"{s.name}: {msg}", bad.span if bad else s.span)
-        ptypes = {p.key: p for p in params}
+        bound = self.match(s.name, params, s.args, f, s.span)
+        ptypes = {q.key: q for p in params for q in (p, *p.alternatives)}
 
         def arg(name: str, default: object = None) -> object:
             a = bound.get(name)
@@ -150,6 +147,7 @@ class InstructionsMixin:
             if p.type in SIGNAL_TYPES:
                 return self.signal_arg(a.value, f, SIGNAL_TYPES[p.type])
             if p.mode == "INOUT":
+                self.changes += 1  # the instruction may change the variable
                 return self.lvalue(a.value, f)  # type: ignore[arg-type]
             return self.coerce(self.eval(a.value, f), p.type, a.value.span)  # type: ignore[union-attr]
 
@@ -205,6 +203,7 @@ class InstructionsMixin:
             if value not in (0, 1):
                 raise self.fail(f"a digital output is 0 or 1, not {fmt_num(value)}", bound["value"].value.span)
             self.pulses.append((self.now + to_ns(delay), sig.name, float(value)))
+            self.changes += 1
         else:
             self.write(sig, value, bound["value"].value.span)
         yield from ()

@@ -2,9 +2,14 @@
 
 Nothing here blocks, sleeps or knows the wall clock. A statement that has to wait *yields* a `Wait`
 to whoever drives the generator (the Controller) and is resumed on a later tick with the clock
-advanced; expressions are evaluated synchronously. Loops that consumed no time during an iteration
-yield a "step" wait on their back edge, so `WHILE TRUE DO ENDWHILE` hands control back every tick
-instead of hanging the cell.
+advanced; expressions are evaluated synchronously.
+
+Time-less loops: a loop iteration (WHILE, FOR, a backward GOTO, a RETRY) during which the program
+was not suspended costs one unit of the tick's *loop budget* (`loop_budget`, 10 000 by default;
+the controller resets `spins` at every tick). While the budget lasts the loop runs on at the same
+instant, so `FOR i FROM 1 TO 1000` ends at the time it started; when it is used up the loop yields a
+"step" wait and goes on at the next tick. `WHILE TRUE DO ENDWHILE` thus hands control back every
+tick instead of hanging the cell.
 
 Errors and ERROR handlers: every statement runs inside a guard. A runtime error (ExecError) in a
 statement of routine R transfers control to R's ERROR handler with ERRNO set; the handler's RETRY
@@ -25,7 +30,7 @@ from .host import Host, SignalInfo
 from .instructions import InstructionsMixin
 from .runtime import (ABSENT, NS, Cell, ExitSignal, Fatal, Frame, GotoSignal, Propagate, Ref, RetrySignal,
                       ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
-from .values import (SIGNAL_KINDS, SIGNAL_TYPES, Aggregate, Array, Record, SignalRef, TypeMismatch, array_type,
+from .values import (SIGNAL_KINDS, SIGNAL_TYPES, Aggregate, Array, Record, SignalRef, TypeMismatch, a_, array_type,
                      coerce, default_value, describe_type, fmt_num, json_num, new_array, pos, xyz)
 
 __all__ = ["Interpreter", "Wait", "NS", "to_ns", "ExitSignal", "Fatal", "Propagate"]
@@ -34,17 +39,26 @@ __all__ = ["Interpreter", "Wait", "NS", "to_ns", "ExitSignal", "Fatal", "Propaga
 class Interpreter(InstructionsMixin):
     """Runs one module against a host; the Controller drives `run()` and sets `now` before each resume."""
 
-    def __init__(self, module: n.Module, host: Host, emit: Callable[[dict], None] | None = None):
+    def __init__(self, module: n.Module, host: Host, emit: Callable[[dict], None] | None = None,
+                 loop_budget: int = 10_000):
         self.module = module
         self.host = host
-        self.emit = emit or (lambda ev: None)
+        self._sink = emit or (lambda ev: None)
         self.signals: dict[str, SignalInfo] = {s.name.lower(): s for s in host.signals()}
+        self.signal_cells = {k: Cell(SIGNAL_KINDS[s.kind], SignalRef(s.name, s.kind), "CONST", s.name)
+                             for k, s in self.signals.items()}
         self.routines = {r.key: r for r in module.routines}
         self.predefined = {k: Cell(t, v, "CONST", k) for k, (t, v) in B.predefined_data().items()}
         self.globals: dict[str, Cell] = {}
         self.predefined_vars: dict[str, Cell] = {}
         self.now = 0  # ns, set by the controller before every resume
         self.suspensions = 0  # bumped by the controller each time the program stays suspended over a tick
+        self.loop_budget = max(1, int(loop_budget))  # time-less loop iterations per tick
+        self.spins = 0  # time-less loop iterations in this tick (reset by the controller every tick)
+        # Bumped by everything that changes the program's state or the world (assignments, loop
+        # variables, INOUT arguments, ERRNO, events) or depends on the time (ClkRead): a tick that
+        # leaves it unchanged and ends at the same loop would do the same again at the next tick.
+        self.changes = 0
         self.errno = 0.0
         self.pulses: list[tuple[int, str, float]] = []  # scheduled writes: (due ns, signal, value)
         self.next_user_errno = B.USER_ERRNO_BASE
@@ -118,6 +132,17 @@ class Interpreter(InstructionsMixin):
             self.host.write_signal(info.name, value)
             self.emit({"type": info.kind, "signal": info.name, "value": json_num(value)})
 
+    def emit(self, event: dict) -> None:
+        self.changes += 1
+        self._sink(event)
+
+    def spin(self, what: str, span: Span):
+        """A loop iteration that consumed no time: one unit of the tick's loop budget; when the
+        budget is used up, wait for the next tick (`span` names the loop)."""
+        self.spins += 1
+        if self.spins >= self.loop_budget:
+            yield Wait("step", what=what, span=span)
+
     # ---- routines -------------------------------------------------------------------------------
     def invoke(self, r: n.Routine, frame: Frame):
         """Run a routine body; an error it does not handle is raised again at the call."""
@@ -131,11 +156,22 @@ class Interpreter(InstructionsMixin):
             raise self.fail(f"FUNC {r.name} ended without RETURN", r.span, "ERR_FNCNORET")
         return None
 
-    def bind(self, r_name: str, params: list[n.Param], args: list[n.Arg], f: Frame, span: Span,
-             frame: Frame) -> None:
+    def match(self, r_name: str, params: list[n.Param], args: list[n.Arg], f: Frame, span: Span) -> dict[str, n.Arg]:
+        """Arguments matched to parameters ({param key: arg}); a conditional argument `\\A?B` whose
+        parameter B is absent in the caller `f` is left out, as if it had not been written."""
         bound, msg, bad = B.match_args(params, args)
         if msg:
             raise self.fail(f"{r_name}: {msg}", bad.span if bad else span)
+        for key, a in list(bound.items()):
+            if a.conditional:
+                cell = f.vars.get(a.value.key)  # type: ignore[union-attr]
+                if cell is None or cell.get() is ABSENT:
+                    del bound[key]
+        return bound
+
+    def bind(self, r_name: str, params: list[n.Param], args: list[n.Arg], f: Frame, span: Span,
+             frame: Frame) -> None:
+        bound = self.match(r_name, params, args, f, span)
         for p in params:
             for q in [p, *p.alternatives]:
                 a = bound.get(q.key)
@@ -175,6 +211,8 @@ class Interpreter(InstructionsMixin):
         i = 0
         mark = self.suspensions
         while i < len(stmts):
+            if type(stmts[i]) is n.Label:  # a backward GOTO's loop turn starts at its label
+                mark = self.suspensions
             try:
                 yield from self.guarded(stmts[i], f)
             except GotoSignal as g:
@@ -182,15 +220,14 @@ class Interpreter(InstructionsMixin):
                               None)
                 if target is None:
                     raise
-                if target <= i and self.suspensions == mark:  # a backward jump is a loop: one step per turn
-                    yield Wait("step", what=f"GOTO {g.label}")
+                if target <= i and self.suspensions == mark:  # a backward jump is a loop
+                    yield from self.spin(f"GOTO {g.label}", stmts[target].span)
                 mark = self.suspensions
                 i = target + 1
                 continue
             i += 1
 
     def guarded(self, s: n.Stmt, f: Frame):
-        quick_retries = 0
         while True:
             mark = self.suspensions
             try:
@@ -207,16 +244,13 @@ class Interpreter(InstructionsMixin):
                 if action == "trynext":
                     return
                 if self.suspensions == mark:
-                    # RETRY is immediate, but a statement retried again and again without time
-                    # passing costs one step per retry, so a RETRY loop cannot hang the cell.
-                    quick_retries += 1
-                    if quick_retries > 1:
-                        yield Wait("step", what="RETRY")
-                else:
-                    quick_retries = 0
+                    # RETRY is immediate, but a retry without time passing is a loop iteration
+                    # like any other: it uses the loop budget, so a RETRY loop cannot hang the cell.
+                    yield from self.spin("RETRY", s.span)
 
     def handler(self, f: Frame, err: ExecError):
         self.errno = float(err.errno)
+        self.changes += 1
         f.in_handler, f.error = True, err
         try:
             yield from self.block(f.routine.error_handler or [], f)
@@ -240,6 +274,7 @@ class Interpreter(InstructionsMixin):
                     raise self.fail(f"type mismatch: {s.target.text} has {{{', '.join(map(str, old.sizes()))}}} "
                                     f"elements, the value {{{', '.join(map(str, value.sizes()))}}}", s.value.span)
             ref.set(value)
+            self.changes += 1
         elif isinstance(s, n.If):
             for cond, body in s.branches:
                 if self.truth(cond, f):
@@ -254,7 +289,7 @@ class Interpreter(InstructionsMixin):
                     return
                 yield from self.block(s.body, f)
                 if self.suspensions == mark:
-                    yield Wait("step", what="WHILE")
+                    yield from self.spin("WHILE", s.span)
         elif isinstance(s, n.For):
             yield from self.for_loop(s, f)
         elif isinstance(s, n.Test):
@@ -268,6 +303,7 @@ class Interpreter(InstructionsMixin):
                 yield from self.block(s.default, f)
         elif isinstance(s, n.LocalDecl):
             f.vars[s.decl.key] = self.declare(s.decl, f)
+            self.changes += 1
         elif isinstance(s, n.Return):
             value = None
             if s.value is not None:
@@ -306,9 +342,10 @@ class Interpreter(InstructionsMixin):
             while (i <= stop) if step > 0 else (i >= stop):
                 mark = self.suspensions
                 cell.value = i
+                self.changes += 1
                 yield from self.block(s.body, f)
                 if self.suspensions == mark:
-                    yield Wait("step", what="FOR")
+                    yield from self.spin("FOR", s.span)
                 i += step
         finally:
             f.vars.pop(key, None)
@@ -336,17 +373,19 @@ class Interpreter(InstructionsMixin):
             return self.predefined[key]
         if key in self.predefined_vars:
             return self.predefined_vars[key]
-        if key in self.signals:
-            s = self.signals[key]
-            return Cell(SIGNAL_KINDS[s.kind], SignalRef(s.name, s.kind), "CONST", s.name)
+        if key in self.signal_cells:
+            return self.signal_cells[key]
         if key == "errno":
             return Cell("errnum", self.errno, "CONST", "ERRNO")
         raise self.fail(f"undefined name '{name}'", span)
 
     def eval(self, e: n.Expr, f: Frame) -> object:
-        if isinstance(e, (n.NumLit, n.StrLit, n.BoolLit)):
-            return e.value
-        if isinstance(e, n.Name):
+        t = type(e)  # the node classes have no subclasses: `type(e) is` is an exact, fast test
+        if t is n.NumLit or t is n.StrLit or t is n.BoolLit:
+            return e.value  # type: ignore[attr-defined]
+        if t is n.Binary:
+            return self.binary(e, f)  # type: ignore[arg-type]
+        if t is n.Name:
             cell = self.lookup(e.name, f, e.span)
             v = cell.get()
             if v is ABSENT:
@@ -502,13 +541,13 @@ class Interpreter(InstructionsMixin):
 
     def signal_arg(self, e: n.Expr | None, f: Frame, kind: str) -> SignalRef:
         if not isinstance(e, n.Name):
-            raise self.fail(f"expected a {kind} signal", e.span if e else None)
+            raise self.fail(f"expected {a_(kind)} signal", e.span if e else None)
         cell = self.lookup(e.name, f, e.span)
         v = cell.get()
         if not isinstance(v, SignalRef):
             raise self.fail(f"{e.name} is not a signal", e.span)
         if v.kind != kind:
-            raise self.fail(f"{e.name} is a {v.kind} signal, a {kind} is needed", e.span)
+            raise self.fail(f"{e.name} is {a_(v.kind)} signal, {a_(kind)} is needed", e.span)
         return v
 
     def proc_call(self, s: n.ProcCall, f: Frame):

@@ -82,12 +82,15 @@ class Aggregate(Expr):
 
 @dataclass
 class Arg:
-    """One argument of a call. Required: `expr` or `name := expr`; optional: `\\Name:=expr` or a switch `\\Name`."""
+    """One argument of a call. Required: `expr` or `name := expr`; optional: `\\Name:=expr` or a switch `\\Name`;
+    conditional: `\\Name?Param`, passed on only when the caller's optional parameter `Param` (the
+    `value`, a Name) is present."""
 
     span: Span
     value: Expr | None
     name: str | None = None
     optional: bool = False
+    conditional: bool = False
 
     @property
     def key(self) -> str | None:

@@ -1,6 +1,13 @@
 """Offline runs: a program against an in-memory host, with simulated time advanced from event to
-event (a WaitTime's end, a WaitUntil poll, a `--set` change, a pulse edge), or by one controller
-step for a loop iteration that consumed no time. Nothing waits on the wall clock.
+event (a WaitTime's end, a WaitUntil poll, a `--set` change, a pulse edge). Nothing waits on the
+wall clock.
+
+Loops that consume no time run up to the controller's loop budget per tick (10 000 iterations);
+a loop that uses it up goes on at the next tick: one `step` (0.012 s) later, or earlier at a
+`--set` change or a pulse edge, so `WHILE di1 = 0 DO ENDWHILE` leaves at exactly the time di1 is
+set. A busy loop that changed nothing in a whole tick (no assignment, no output, no loop variable,
+no clock read) and ended it at the same loop would do exactly the same at every tick until an
+input changes, so the runner skips straight to the next `--set`, pulse edge or time limit.
 
 `--set` changes at time T are applied before the program runs at T.
 """
@@ -10,7 +17,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from . import nodes as n
-from .controller import ERROR, Controller
+from .controller import DEFAULT_LOOP_BUDGET, ERROR, WAITING, Controller
 from .errors import ExecError
 from .host import InMemoryHost, SignalInfo
 from .interpreter import NS, to_ns
@@ -40,7 +47,7 @@ DEFAULT_TIME_LIMIT = 3600.0
 def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[SignalChange] = (),
                 entry: str = "main", max_time: float | None = None, step: float = 0.012,
                 on_event: Callable[[dict], None] | None = None,
-                default_limit: float = DEFAULT_TIME_LIMIT) -> Outcome:
+                default_limit: float = DEFAULT_TIME_LIMIT, loop_budget: int = DEFAULT_LOOP_BUDGET) -> Outcome:
     """Run `module` from `entry` until it ends, fails or `max_time` passes. Raises CheckError for
     static errors (nothing has run then).
 
@@ -56,7 +63,7 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
     host = InMemoryHost(list(signals))
     names = {s.name.lower(): s.name for s in signals}
     pending = sorted(((to_ns(c.t), i, c) for i, c in enumerate(changes)), key=lambda x: (x[0], x[1]))
-    ctl = Controller(module, host, entry, on_event=emit, step=step)
+    ctl = Controller(module, host, entry, on_event=emit, step=step, loop_budget=loop_budget)
     limit = None if max_time is None else to_ns(max_time)
     fallback = to_ns(default_limit)
 
@@ -65,11 +72,26 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
             _, _, c = pending.pop(0)
             host.set_input(names[c.name.lower()], c.value)
 
+    def tick(now: int) -> bool:
+        """Tick the controller; True when it only went round a loop that changed nothing."""
+        before, changes = ctl.wait, ctl.interp.changes
+        ctl.tick_ns(now)
+        after = ctl.wait
+        return (ctl.state == WAITING and before is not None and after is not None and before.kind == "step"
+                and after.kind == "step" and after.span == before.span and after.what == before.what
+                and ctl.interp.changes == changes)
+
     now = 0
     apply(now)
-    ctl.tick_ns(now)
+    idle = tick(now)
     while not ctl.finished:
-        times = [t for t in (ctl.next_wake_ns(), pending[0][0] if pending else None) if t is not None]
+        wake = None if idle else ctl.next_wake_ns()  # an idle loop: only an input or a pulse can matter
+        if idle and ctl.interp.pulses:
+            wake = min(p[0] for p in ctl.interp.pulses)
+        times = [t for t in (wake, pending[0][0] if pending else None) if t is not None]
+        if idle and not times:
+            now = limit if limit is not None else fallback
+            break
         if not times:
             if limit is not None:
                 now = limit
@@ -88,7 +110,7 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
             break
         now = nxt
         apply(now)
-        ctl.tick_ns(now)
+        idle = tick(now)
     else:
         if ctl.state == ERROR:
             return Outcome("error", now / NS, ctl.error, host, events)  # type: ignore[arg-type]

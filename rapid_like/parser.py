@@ -2,7 +2,11 @@
 
 Hand-written rather than lark because the messages matter more than the grammar's size: a block
 that is not closed is reported at the token where its END word was expected, naming the opener
-("expected ENDIF to close the IF on line 4, found ENDPROC"). The first error stops the parse.
+("expected ENDIF to close the IF on line 4, found ENDPROC"), also when another END word stands
+there ("... found ENDWHILE") or a misspelt one ("... found 'ENDFI'"). A closing word with no
+block open to take it is "ENDIF without IF". An IF whose THEN is missing reads as a compact IF
+(`IF cond instruction;`, valid on any lines); when that reading leads to an error and the reading
+with THEN does not, the error is the missing THEN, on the IF's line. The first error stops the parse.
 
 Operator precedence follows the RAPID manual, highest first:
     * / DIV MOD  >  + -  >  = <> < <= > >=  >  AND  >  OR XOR NOT
@@ -11,6 +15,8 @@ comparison (`a < b < c` is an error) and NOT, the loosest, negates a whole AND-c
 (`NOT a AND b` is `NOT (a AND b)`).
 """
 from __future__ import annotations
+
+import difflib
 
 from . import nodes as n
 from .errors import ParseError, Span
@@ -26,6 +32,16 @@ _RELOPS = ("=", "<>", "<", "<=", ">", ">=")
 _OWNER = {"ENDIF": "IF", "ELSE": "IF", "ELSEIF": "IF", "ENDWHILE": "WHILE", "ENDFOR": "FOR",
           "ENDTEST": "TEST", "CASE": "TEST", "DEFAULT": "TEST", "ENDPROC": "PROC", "ENDFUNC": "FUNC",
           "ERROR": "PROC or FUNC", "ENDMODULE": "MODULE", "ENDTRAP": "TRAP"}
+# Words that end a routine or the module: in a routine body, they are a wrong END word, not a stray one.
+_ROUTINE_ENDS = {"ENDPROC", "ENDFUNC", "ENDTRAP", "ENDMODULE"}
+# The END words an identifier may be a misspelling of ("ENDFI", "END_IF", "EndWhile1").
+_END_WORDS = ("ENDIF", "ENDWHILE", "ENDFOR", "ENDTEST", "ENDPROC", "ENDFUNC", "ENDMODULE")
+
+
+def _looks_like_end_word(word: str) -> bool:
+    w = word.upper()
+    return w in ("END", "END_") or w.startswith("END_") or \
+        bool(difflib.get_close_matches(w, _END_WORDS, n=1, cutoff=0.75))
 
 
 def parse(source: str, file: str = "<input>") -> n.Module:
@@ -40,6 +56,8 @@ class Parser:
         self.source = source
         self.file = file
         self.open_closers: list[tuple[str, ...]] = []  # closing words of the blocks being parsed
+        self.assume_then: set[int] = set()  # IF tokens (indexes) to read as if THEN followed the condition
+        self.compact_ifs: list[tuple[int, int]] = []  # (IF token index, index after its condition)
         self.line_starts = [0]
         for i, ch in enumerate(source):
             if ch == "\n":
@@ -73,7 +91,7 @@ class Parser:
     def expect_kw(self, word: str, what: str = "") -> Token:
         if self.tok.is_kw(word):
             return self.advance()
-        raise self.error(f"expected {word}{what}, found {self.found()}")
+        raise self.missing_word(word, what, self.pos)
 
     def expect_op(self, op: str, what: str = "", at_previous: bool = False) -> Token:
         if self.tok.is_op(op):
@@ -171,6 +189,56 @@ class Parser:
         return n.DataDecl(kw.span, storage, ttok.text.lower(), ttok.span, name.text, init, local, dims)
 
     def routine(self, local: bool) -> n.Routine:
+        """A PROC or FUNC. When it does not parse and one of its compact IFs would parse further as
+        an IF ... THEN, the error is that IF's missing THEN."""
+        start, compact = self.pos, len(self.compact_ifs)
+        try:
+            return self.routine_body(local)
+        except ParseError as err:
+            candidates = [c for c in self.compact_ifs[compact:] if self.toks[c[0]].offset < self._offset(err)]
+            del self.compact_ifs[compact:]
+            for if_index, after_cond in reversed(candidates):
+                if self._parses_further_with_then(start, if_index, local, err):
+                    raise self.missing_then(after_cond) from None
+            raise
+
+    def missing_then(self, after_cond: int) -> ParseError:
+        """THEN is missing before token `after_cond` (reported on the IF's line)."""
+        return self.missing_word("THEN", " after the IF condition", after_cond)
+
+    def missing_word(self, word: str, what: str, at: int) -> ParseError:
+        """`word` expected before token `at`. When that token starts a later line, the error is
+        reported just after the previous token, where the word belongs (`IF cond` / `WHILE cond`
+        with THEN / DO forgotten at the end of the line), naming the line of what was found."""
+        prev, nxt = self.toks[at - 1], self.toks[at]
+        if at > 0 and nxt.span.line > prev.span.line:
+            return ParseError(f"expected {word}{what}, found {nxt.describe()} on line {nxt.span.line}",
+                              Span(self.file, prev.span.line, prev.span.col + (prev.end - prev.offset)))
+        return ParseError(f"expected {word}{what}, found {nxt.describe()}", nxt.span)
+
+    def _offset(self, err: ParseError) -> int:
+        span = err.span
+        if span is None or span.line > len(self.line_starts):
+            return len(self.source)
+        return self.line_starts[span.line - 1] + span.col - 1
+
+    def _parses_further_with_then(self, start: int, if_index: int, local: bool, err: ParseError) -> bool:
+        """Does the routine at token `start` parse (or fail later than `err`) with a THEN assumed
+        after the condition of the IF at token `if_index`?"""
+        saved = (self.pos, len(self.compact_ifs))
+        self.pos = start
+        self.assume_then.add(if_index)
+        try:
+            self.routine_body(local)
+            return True
+        except ParseError as again:
+            return self._offset(again) > self._offset(err)
+        finally:
+            self.assume_then.discard(if_index)
+            self.pos = saved[0]
+            del self.compact_ifs[saved[1]:]
+
+    def routine_body(self, local: bool) -> n.Routine:
         kw = self.advance()
         kind = kw.upper
         rtype = None
@@ -244,17 +312,33 @@ class Parser:
         reported as the missing `expected` word of `opener`."""
         stmts: list[n.Stmt] = []
         self.open_closers.append(closers)
+        in_routine = expected in ("ENDPROC", "ENDFUNC")  # the body (or ERROR handler) of a routine
         try:
             while True:
                 t = self.tok
                 if t.kind is Kind.KEYWORD and t.upper in closers:
                     return stmts
-                if t.kind is Kind.KEYWORD and t.upper in _CLOSERS and t.upper != "ENDMODULE" and \
-                        not any(t.upper in c for c in self.open_closers):
+                if in_routine and t.is_kw("ERROR") and "ERROR" not in closers:
+                    raise self.error(f"a second ERROR in the {opener}: a routine has one ERROR handler")
+                if in_routine and t.kind is Kind.KEYWORD and t.upper in _CLOSERS and \
+                        t.upper not in _ROUTINE_ENDS and not any(t.upper in c for c in self.open_closers):
                     raise self.error(f"{t.upper} without {_OWNER[t.upper]}: no {_OWNER[t.upper]} is open here")
                 if t.kind is Kind.EOF or (t.kind is Kind.KEYWORD and t.upper in _CLOSERS) or \
-                        t.is_kw("PROC", "FUNC", "ENDMODULE"):
-                    raise self.error(f"expected {expected} to close the {opener}, found {self.found()}")
+                        t.is_kw("PROC", "FUNC", "TRAP", "ENDMODULE", "ENDTRAP"):
+                    hint = ""
+                    last = stmts[-1] if stmts else None
+                    if isinstance(last, n.ProcCall) and not last.args and _looks_like_end_word(last.name):
+                        hint = f" (is '{last.name}' on line {last.span.line} meant to be {expected}?)"
+                    raise self.error(f"expected {expected} to close the {opener}, found {self.found()}{hint}")
+                if t.kind is Kind.IDENT and _looks_like_end_word(t.text):
+                    # `ENDFI`, `END IF`, `ENDWHILE1`...: if it is no instruction, it is the missing END word
+                    at = self.pos
+                    try:
+                        stmts.append(self.statement())
+                    except ParseError:
+                        self.pos = at
+                        raise self.error(f"expected {expected} to close the {opener}, found '{t.text}'") from None
+                    continue
                 stmts.append(self.statement())
         finally:
             self.open_closers.pop()
@@ -283,6 +367,9 @@ class Parser:
                 label = self.expect_ident("a label after GOTO")
                 self.end_of_instruction()
                 return n.Goto(t.span, label.text, label.span)
+        prev = self.toks[self.pos - 1] if self.pos else None
+        if t.is_op(";") and prev is not None and prev.kind is Kind.KEYWORD and prev.upper in _CLOSERS | _ROUTINE_ENDS:
+            raise self.error(f"unexpected ';' after {prev.upper}: a closing word takes no ';'")
         raise self.error(f"expected an instruction, found {self.found()}")
 
     def keyword_instruction(self) -> n.Stmt:
@@ -343,10 +430,16 @@ class Parser:
                 self.advance()
                 name = self.expect_ident(f"an optional argument name after '\\' in {what}")
                 value = None
+                conditional = False
                 if self.tok.is_op(":="):
                     self.advance()
                     value = self.expression()
-                args.append(n.Arg(t.span, value, name.text, True))
+                elif self.tok.is_op("?"):  # a conditional argument: \Speed?Speed
+                    self.advance()
+                    param = self.expect_ident(f"the name of an optional parameter after '\\{name.text}?'")
+                    value = n.Name(param.span, param.text, param.text)
+                    conditional = True
+                args.append(n.Arg(t.span, value, name.text, True, conditional))
                 need_comma = True
                 continue
             if need_comma and args and not args[-1].optional:
@@ -368,15 +461,18 @@ class Parser:
         return args
 
     def if_stmt(self) -> n.Stmt:
+        if_index = self.pos
         kw = self.advance()
         cond = self.expression()
-        if not self.tok.is_kw("THEN"):
+        if not self.tok.is_kw("THEN") and if_index not in self.assume_then:
             # compact IF: IF cond instruction;
             if self.tok.kind is Kind.IDENT or self.tok.is_kw("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE", "GOTO"):
+                self.compact_ifs.append((if_index, self.pos))
                 body = [self.statement()]
                 return n.If(kw.span, [(cond, body)], None, compact=True)
-            raise self.error(f"expected THEN after the IF condition, found {self.found()}")
-        self.advance()
+            raise self.missing_then(self.pos)
+        if self.tok.is_kw("THEN"):
+            self.advance()
         opener = f"IF on line {kw.span.line}"
         branches = [(cond, self.block(("ELSEIF", "ELSE", "ENDIF"), "ENDIF", opener))]
         orelse = None
@@ -386,8 +482,11 @@ class Parser:
             self.expect_kw("THEN", " after the ELSEIF condition")
             branches.append((c, self.block(("ELSEIF", "ELSE", "ENDIF"), "ENDIF", opener)))
         if self.tok.is_kw("ELSE"):
-            self.advance()
-            orelse = self.block(("ENDIF",), "ENDIF", opener)
+            else_line = self.advance().span.line
+            orelse = self.block(("ENDIF", "ELSEIF", "ELSE"), "ENDIF", opener)
+            if self.tok.is_kw("ELSEIF", "ELSE"):
+                raise self.error(f"{self.tok.upper} after ELSE in the {opener}: ELSE (line {else_line}) must be "
+                                 f"its last branch")
         self.expect_kw("ENDIF")
         return n.If(kw.span, branches, orelse)
 
@@ -434,9 +533,9 @@ class Parser:
         if self.tok.is_kw("DEFAULT"):
             self.advance()
             self.expect_op(":", " after DEFAULT")
-            default = self.block(("ENDTEST",), "ENDTEST", opener)
-        if self.tok.is_kw("CASE"):
-            raise self.error("CASE after DEFAULT: DEFAULT must be the last branch of a TEST")
+            default = self.block(("ENDTEST", "CASE", "DEFAULT"), "ENDTEST", opener)
+        if self.tok.is_kw("CASE", "DEFAULT"):
+            raise self.error(f"{self.tok.upper} after DEFAULT in the {opener}: DEFAULT must be its last branch")
         self.expect_kw("ENDTEST", f" to close the {opener}")
         return n.Test(kw.span, subject, cases, default)
 

@@ -22,7 +22,8 @@ class Wait:
     """What a suspended program waits for.
 
     kind "time" / "poll": resume at the first tick with now >= at.
-    kind "step": a time-less loop iteration; resume at the next tick (or at `at` when set).
+    kind "step": a loop used up the tick's loop budget; ready at the next tick, whenever it comes
+    (`at`, set for event-driven runners, is when that tick is due at the latest).
     kind "signal" / "motion": re-evaluate on every tick; `at` (a timeout) is only a hint for
     event-driven runners: nothing changes before `at` unless a signal does.
     kind "stop": the program executed Stop; it waits for resume() or start().

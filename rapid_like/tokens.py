@@ -33,7 +33,7 @@ KEYWORDS = frozenset(
 
 # Multi-character operators first, so the lexer tries them before their prefixes.
 OPERATORS = (":=", "<>", "<=", ">=", "<", ">", "=", "+", "-", "*", "/", "(", ")", "[", "]",
-             "{", "}", ",", ";", ":", ".", "\\", "|", "%")
+             "{", "}", ",", ";", ":", ".", "\\", "|", "%", "?")
 
 
 @dataclass(frozen=True)

@@ -197,7 +197,7 @@ def coerce(v: object, t: str) -> object:
                 return v.copy()
         elif isinstance(v, Aggregate):
             if len(v) != len(spec):
-                raise TypeMismatch(f"a {t} has {len(spec)} components, the aggregate has {len(v)}")
+                raise TypeMismatch(f"{a_(t)} has {len(spec)} components, the aggregate has {len(v)}")
             out = {}
             for (name, ft), item in zip(spec, v):
                 try:
@@ -234,12 +234,28 @@ def describe_type(v: object) -> str:
     return type_of(v)
 
 
+def a_(word: str) -> str:
+    """`word` with its indefinite article: "a num", "an orient", "a DO", "an AO"."""
+    if not word:
+        return word
+    if word.isupper() and len(word) <= 3:  # an acronym is read letter by letter: "an AO", "an SI", "a DI"
+        return ("an " if word[0] in "AEFHILMNORSX" else "a ") + word
+    return ("an " if word[0].lower() in "aeiou" else "a ") + word
+
+
 def fmt_num(x: float, digits: int = 6) -> str:
-    """A num as RAPID writes it: integers without a decimal point, others with up to 6 significant digits."""
+    """A num as TPWrite \\Num, ValToStr and messages show it, RAPID's standard format: 6 significant
+    digits, a number within 0.000005 of an integer shown as that integer, an exponent when the
+    digits do not reach the decimal point (`1.23457E+06`, `9E+09`, `1.5E-05`), never `-0`."""
     if isinstance(x, bool):
         return "TRUE" if x else "FALSE"
-    if math.isfinite(x) and x == int(x) and abs(x) < 1e15:
-        return str(int(x))
+    if not math.isfinite(x):
+        return "-inf" if x < 0 else "inf" if x > 0 else "nan"
+    r = round(x)
+    if abs(x - r) < 0.000005:
+        x = float(r)
+    if x == 0:
+        return "0"
     s = f"{x:.{digits}g}"
     if "e" in s:
         mant, exp = s.split("e")

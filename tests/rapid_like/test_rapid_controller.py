@@ -9,10 +9,10 @@ from rapid_like import CheckError, Controller, Host, InMemoryHost, MotionRequest
 DT = 0.012
 
 
-def make(src: str, signals=(), entry="main", host=None, step=None):
+def make(src: str, signals=(), entry="main", host=None, step=None, **kw):
     events: list[dict] = []
     host = host or InMemoryHost([SignalInfo(n, k) for k, n in signals])
-    ctl = Controller(parse(src, "t.mod"), host, entry, on_event=events.append, step=step)
+    ctl = Controller(parse(src, "t.mod"), host, entry, on_event=events.append, step=step, **kw)
     return ctl, host, events
 
 
@@ -42,8 +42,8 @@ def test_in_memory_host_satisfies_the_host_protocol():
     assert isinstance(InMemoryHost([]), Host)
 
 
-def test_a_time_less_loop_yields_once_per_tick():
-    ctl, host, _ = make("""
+def test_a_time_less_loop_runs_its_budget_then_yields_at_every_tick():
+    src = """
         MODULE M
           VAR num n := 0;
           PROC main()
@@ -51,11 +51,89 @@ def test_a_time_less_loop_yields_once_per_tick():
               Incr n;
             ENDWHILE
           ENDPROC
-        ENDMODULE""")
+        ENDMODULE"""
+    ctl, host, _ = make(src, loop_budget=25)
     for k in range(50):
         ctl.tick(k * DT)  # returns: the loop does not hang the caller
     assert ctl.state == "waiting"
-    assert ctl.interp.globals["n"].value == 50  # one iteration per tick
+    assert ctl.interp.globals["n"].value == 50 * 25  # the budget's worth of iterations per tick
+    ctl, host, _ = make(src)
+    ctl.tick(0.0)
+    assert ctl.interp.globals["n"].value == 10_000  # the default budget
+
+
+def test_a_loop_within_the_budget_takes_no_time():
+    ctl, _, events = make("""
+        MODULE M
+          PROC main()
+            VAR num sum := 0;
+            FOR i FROM 1 TO 1000 DO
+              sum := sum + i;
+            ENDFOR
+            TPWrite "sum=" \\Num:=sum;
+            FOR i FROM 1 TO 3 DO
+              TPWrite "i=" \\Num:=i;
+            ENDFOR
+          ENDPROC
+        ENDMODULE""")
+    ctl.tick(0.0)
+    assert ctl.state == "completed"
+    assert prints(events) == [(0.0, "sum=500500"), (0.0, "i=1"), (0.0, "i=2"), (0.0, "i=3")]
+
+
+def test_a_loop_longer_than_the_budget_goes_on_at_the_next_ticks():
+    ctl, _, events = make("""
+        MODULE M
+          PROC main()
+            VAR num sum := 0;
+            FOR i FROM 1 TO 1000 DO
+              sum := sum + i;
+            ENDFOR
+            TPWrite "sum=" \\Num:=sum;
+          ENDPROC
+        ENDMODULE""", loop_budget=300)
+    k = 0
+    while ctl.state != "completed":
+        ctl.tick(k * DT)
+        k += 1
+    assert prints(events) == [(0.036, "sum=500500")]  # 300 + 300 + 300 + 100 iterations: 4 ticks
+
+
+def test_a_busy_loop_in_a_station_binding_reacts_at_the_tick_an_input_changes():
+    ctl, host, events = make("""
+        MODULE M
+          PROC main()
+            WHILE di1 = 0 DO
+            ENDWHILE
+            TPWrite "seen";
+          ENDPROC
+        ENDMODULE""", signals=[("DI", "di1")], loop_budget=50)
+    for k in range(10):
+        ctl.tick(k * DT)
+    assert prints(events) == [] and ctl.wait.kind == "step"
+    host.set_input("di1", 1)
+    ctl.tick(10 * DT)
+    assert prints(events) == [(0.12, "seen")]
+
+
+def test_a_retry_loop_without_time_uses_the_loop_budget():
+    ctl, _, events = make("""
+        MODULE M
+          VAR num zero := 0;
+          VAR num tries := 0;
+          PROC main()
+            VAR num r;
+            r := 1 / zero;
+          ERROR
+            Incr tries;
+            RETRY;
+          ENDPROC
+        ENDMODULE""", loop_budget=40)
+    ctl.tick(0.0)
+    assert ctl.state == "waiting" and ctl.wait.what == "RETRY"
+    assert ctl.interp.globals["tries"].value == 40
+    ctl.tick(DT)
+    assert ctl.interp.globals["tries"].value == 80
 
 
 def test_wait_time_resumes_at_the_first_tick_after_its_end():

@@ -88,3 +88,11 @@ def test_an_output_of_the_twin_cannot_be_driven(tmp_path):
     toml.write_text(toml.read_text().replace('drives = "L3"', 'drives = "doGripped"'))
     with pytest.raises(StationError, match=r"controller\.io\[7\]\.drives: aoAxis2: 'doGripped' is an output"):
         open_cell(station)
+
+
+def test_the_station_binding_gives_a_busy_loop_a_small_budget_per_step():
+    from rapid_like.controller import DEFAULT_LOOP_BUDGET
+    from rapid_like.station_host import STATION_LOOP_BUDGET
+
+    with open_cell(RIG) as twin:
+        assert twin.controller.interp.loop_budget == STATION_LOOP_BUDGET < DEFAULT_LOOP_BUDGET

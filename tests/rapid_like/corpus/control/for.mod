@@ -1,13 +1,12 @@
-! FOR counts FROM..TO with an optional STEP (default -1 when counting down). Each iteration that
-! consumes no time costs one controller step (--step, here 0.1 s).
-! args: --step 0.1
+! FOR counts FROM..TO with an optional STEP (default -1 when counting down). Iterations that
+! consume no time run at the same instant (within the controller's loop budget).
 ! trace: {"t": 0.0, "type": "print", "text": "up 1"}
-! trace: {"t": 0.1, "type": "print", "text": "up 3"}
-! trace: {"t": 0.2, "type": "print", "text": "up 5"}
-! trace: {"t": 0.3, "type": "print", "text": "down 2"}
-! trace: {"t": 0.4, "type": "print", "text": "down 1"}
-! trace: {"t": 0.5, "type": "print", "text": "after"}
-! trace: {"t": 0.5, "type": "end", "reason": "completed"}
+! trace: {"t": 0.0, "type": "print", "text": "up 3"}
+! trace: {"t": 0.0, "type": "print", "text": "up 5"}
+! trace: {"t": 0.0, "type": "print", "text": "down 2"}
+! trace: {"t": 0.0, "type": "print", "text": "down 1"}
+! trace: {"t": 0.0, "type": "print", "text": "after"}
+! trace: {"t": 0.0, "type": "end", "reason": "completed"}
 MODULE Counting
   PROC main()
     FOR i FROM 1 TO 6 STEP 2 DO

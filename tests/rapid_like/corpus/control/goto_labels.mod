@@ -1,12 +1,11 @@
 ! GOTO jumps to a label in the same block or a block around it (the manual's compact IF example
-! `IF reg1 > 5 GOTO next;`); a backward jump is a loop and costs a step when it waits for nothing.
-! args: --step 0.1
+! `IF reg1 > 5 GOTO next;`); a backward jump is a loop, and within the loop budget it takes no time.
 ! trace: {"t": 0.0, "type": "print", "text": "reg1=1"}
-! trace: {"t": 0.1, "type": "print", "text": "reg1=3"}
-! trace: {"t": 0.2, "type": "print", "text": "reg1=5"}
-! trace: {"t": 0.3, "type": "print", "text": "reg1=7"}
-! trace: {"t": 0.3, "type": "print", "text": "at next"}
-! trace: {"t": 0.3, "type": "end", "reason": "completed"}
+! trace: {"t": 0.0, "type": "print", "text": "reg1=3"}
+! trace: {"t": 0.0, "type": "print", "text": "reg1=5"}
+! trace: {"t": 0.0, "type": "print", "text": "reg1=7"}
+! trace: {"t": 0.0, "type": "print", "text": "at next"}
+! trace: {"t": 0.0, "type": "end", "reason": "completed"}
 MODULE Jumps
   PROC main()
     reg1 := 1;

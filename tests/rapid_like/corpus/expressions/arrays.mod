@@ -1,12 +1,10 @@
 ! Arrays: declared sizes, aggregate initial values, 1-based indexes (also in assignments, INOUT
-! arguments and components), value semantics, array parameters {*} and Dim. Fill's six time-less
-! inner loop iterations cost one 1 ms step each (a FUNC's loops cost nothing).
+! arguments and components), value semantics, array parameters {*} and Dim.
 ! trace: {"t": 0.0, "type": "print", "text": "counts=[1,20,3] copy=[100,20,3]"}
 ! trace: {"t": 0.0, "type": "print", "text": "sum=24 c3=4"}
-! trace: {"t": 0.006, "type": "print", "text": "grid=[[11,12,13],[21,22,23]]"}
-! trace: {"t": 0.006, "type": "move", "instr": "MoveL", "to": {"trans": [4, 5, 6], "rot": [1, 0, 0, 0]}, "speed": "v100", "zone": "fine", "tool": "tool0", "wobj": "wobj0"}
-! trace: {"t": 0.006, "type": "end", "reason": "completed"}
-! args: --step 0.001
+! trace: {"t": 0.0, "type": "print", "text": "grid=[[11,12,13],[21,22,23]]"}
+! trace: {"t": 0.0, "type": "move", "instr": "MoveL", "to": {"trans": [4, 5, 6], "rot": [1, 0, 0, 0]}, "speed": "v100", "zone": "fine", "tool": "tool0", "wobj": "wobj0"}
+! trace: {"t": 0.0, "type": "end", "reason": "completed"}
 MODULE Arrays
   VAR num counts{3} := [1, 2, 3];
   VAR num grid{2,3};

@@ -1,9 +1,10 @@
-! A loop that waits for nothing still gives up one controller step per iteration (0.012 s by
-! default), so polling a signal set from outside ends: the change at 0.1 is seen at 0.108,
-! after 9 iterations (t = 0, 0.012, ..., 0.096).
+! A loop that waits for nothing runs its loop budget (10 000 iterations) per controller tick and
+! then hands control back until the next tick, so polling a signal set from outside ends: ticks at
+! t = 0, 0.012, ..., 0.096 run 9 x 10 000 polls, and the change at 0.1 is seen at exactly 0.1
+! (a loop waiting for its next tick goes on at whichever tick comes first).
 ! args: --io DI:diStart --set diStart=1@0.1
-! trace: {"t": 0.108, "type": "print", "text": "started after 9 polls"}
-! trace: {"t": 0.108, "type": "end", "reason": "completed"}
+! trace: {"t": 0.1, "type": "print", "text": "started after 90000 polls"}
+! trace: {"t": 0.1, "type": "end", "reason": "completed"}
 MODULE Busy
   PROC main()
     VAR num polls := 0;
