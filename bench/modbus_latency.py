@@ -6,7 +6,7 @@ Both servers run in their own process on loopback; the client side is one proces
 sockets (so the figures are the servers', not a client library's). Measured in one run, side by side:
 
 - round-trip latency of one register read (FC 4, all the station's input registers from GrippedPart
-  on: 23 on the ring rig; the same addresses on both), one request at a time on one connection: p50 and p99;
+  on: 41 on the ring rig; the same addresses on both), one request at a time on one connection: p50 and p99;
 - throughput: requests per second with 1 client, then with C clients (default 10) each polling
   request-after-response over its own connection;
 - for `twin serve`: how many simulation steps were late (finished after their wall-clock deadline)

@@ -135,3 +135,24 @@ def test_a_failing_step_sets_the_fault_bit_freezes_the_outputs_and_writes_get_ex
     assert x == b"\x04\x02" + struct.pack(">H", 5000)  # 50.00 mm: the last completed step
     assert refused == b"\x86\x04"
     assert any("simulation fault at step 2" in line and "gave up" in line for line in logs)
+
+
+def test_a_write_reads_back_at_once_and_no_publish_undoes_it_before_it_is_applied():
+    twin = StandIn()
+    rmap = build_register_map(twin.signals, "stand-in")
+    bridge = TwinBridge(twin, rmap)
+    target, go = rmap["target"], rmap["go"]
+
+    def holding(entry) -> int:
+        return struct.unpack_from(">H", bridge.images.holding, 2 * entry.address)[0]
+
+    assert bridge.submit([(target, 0.05), (go, True)]) == 0
+    assert holding(target) == 5000 and bridge.images.coils[go.address] == 1  # at once
+    assert twin.values["target"] == 0.0  # not applied yet: that is the next step's job
+    bridge.publish()  # a publish before the step (whoever calls it) keeps what was written
+    assert holding(target) == 5000 and bridge.images.coils[go.address] == 1
+    x = rmap["x"]
+    assert struct.unpack_from(">H", bridge.images.input_registers, 2 * x.address)[0] == 0  # outputs: last step
+    assert bridge.step()
+    assert twin.values["target"] == 0.05 and holding(target) == 5000
+    assert struct.unpack_from(">H", bridge.images.input_registers, 2 * x.address)[0] == 5000

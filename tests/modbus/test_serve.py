@@ -256,3 +256,41 @@ def test_the_ring_rig_serves_its_robot_axes_in_hundredths_of_a_degree():
         assert not ok(c.read_discrete_inputs(rmap["robot.busy"].address, count=1, device_id=UNIT)).bits[0]
         assert rmap["L2.actual"].decode(ok(c.read_input_registers(rmap["L2.actual"].address, count=1,
                                                                   device_id=UNIT)).registers) == pytest.approx(350, abs=1)
+
+
+def test_a_port_out_of_range_is_a_usage_error_not_a_traceback():
+    r = subprocess.run([sys.executable, "-m", "twin", "serve", str(RING_BENCH), "--port", "70000"],
+                       capture_output=True, text=True, cwd=ROOT, timeout=60)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert "a TCP port is 0..65535, not 70000" in r.stderr.splitlines()[-1]
+
+
+def start_and_signal(*signals: int) -> tuple[int, str]:
+    """Start `twin serve` on the ring rig, send `signals` as soon as it says it is loading the station
+    (which takes ~0.3 s, pybullet, before the event loop takes the signals over); (exit code, stderr)."""
+    cmd = [sys.executable, "-m", "twin", "serve", str(ROOT / "stations" / "ring_rig"), "--port", "0"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    try:
+        first = proc.stderr.readline()
+        assert "loading station" in first, first
+        for sig in signals:
+            proc.send_signal(sig)
+        err = first + proc.stderr.read()
+        proc.wait(30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    return proc.returncode, err
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_while_the_station_is_still_loading_stops_cleanly(sig):
+    code, err = start_and_signal(sig)
+    assert code == 0 and "Traceback" not in err, err
+    assert f"stopped by {sig.name} while starting" in err and "listening" not in err, err
+
+
+def test_a_second_signal_while_loading_cuts_the_loading_short():
+    code, err = start_and_signal(signal.SIGTERM, signal.SIGINT)  # pending together: the lowest number first
+    assert code == 0 and "stopped by SIGINT while starting" in err and "listening" not in err, err

@@ -120,19 +120,49 @@ def test_all_supported_functions_on_the_wire(raw):
     assert raw.request(pdu(4, 0, 9))[:2] == bytes([4, 18])
     assert raw.request(pdu(6, L3, 33000)) == pdu(6, L3, 33000)
     assert raw.request(bytes([16]) + struct.pack(">HHBHH", L2, 2, 4, 33000, 33000)) == pdu(16, L2, 2)
-    # 23: write L4, read L2..L5 in one request (the write shows after the next step)
+    # 23: write L4, read L2..L5 in one request
     resp = raw.request(bytes([23]) + struct.pack(">HHHHBH", L2, 4, 18, 1, 2, 33000))
     assert resp[:2] == bytes([23, 8])
 
 
-def test_a_write_takes_effect_at_the_next_step_and_a_read_sees_the_last_completed_step(raw):
+def read_ir(raw: Raw, address: int, count: int = 1) -> list[int]:
+    resp = raw.request(pdu(4, address, count))
+    assert resp[:2] == bytes([4, 2 * count]), resp
+    return list(struct.unpack(f">{count}H", resp[2:]))
+
+
+def outputs(raw: Raw) -> tuple[bytes, bytes]:
+    """Every discrete input and input register of the ring bench, raw."""
+    bits = raw.request(pdu(2, 0, 3)) + raw.request(pdu(2, 16, 12))
+    return bits, raw.request(pdu(4, 0, 9)) + raw.request(pdu(4, 16, 17))
+
+
+def test_a_write_reads_back_at_once_and_takes_effect_at_the_next_step(raw):
     old = read_hr(raw, L2)[0]
     new = 32900 if old != 32900 else 32800
+    before, actual = outputs(raw), read_ir(raw, 17, 3)  # L2..L4.actual
     assert raw.request(pdu(6, L2, new)) == pdu(6, L2, new)
-    assert read_hr(raw, L2) == [old]  # not stepped yet
+    assert read_hr(raw, L2) == [new]  # an input reads back what was written, before any step
+    assert raw.request(pdu(5, 17, 0x0000)) == pdu(5, 17, 0x0000)  # ring.present off
+    assert raw.request(pdu(1, 16, 2)) == bytes([1, 1, 0b01])  # Active on, ring.present off at once
+    assert raw.request(bytes([16]) + struct.pack(">HHBHH", L3, 2, 4, 32950, 32960)) == pdu(16, L3, 2)
+    assert read_hr(raw, L2, 3) == [new, 32950, 32960]
+    assert outputs(raw) == before  # outputs: still the last completed step
     advance(raw, 1)
-    assert read_hr(raw, L2) == [new]
-    raw.request(pdu(6, L2, 33000))
+    moved = read_ir(raw, 17, 3)
+    assert all(m != a for m, a in zip(moved, actual)), (actual, moved)  # the step applied the writes
+    assert read_hr(raw, L2, 3) == [new, 32950, 32960]  # and its publish kept them
+    assert raw.request(pdu(1, 16, 2)) == bytes([1, 1, 0b01])
+    raw.request(bytes([16]) + struct.pack(">HHBHHH", L2, 3, 6, 33000, 33000, 33000))
+    raw.request(pdu(5, 17, 0xFF00))
+    advance(raw, 1)
+
+
+def test_function_23_writes_first_then_reads_and_the_read_sees_the_write(raw):
+    resp = raw.request(bytes([23]) + struct.pack(">HHHHBH", L2, 4, 18, 1, 2, 32990))
+    assert resp[:2] == bytes([23, 8]) and struct.unpack(">4H", resp[2:])[2] == 32990
+    assert read_hr(raw, 18) == [32990]
+    raw.request(pdu(6, 18, 33000))
     advance(raw, 1)
 
 
@@ -179,6 +209,7 @@ def test_a_stalled_half_frame_is_dropped_after_the_timeout_not_glued_to_the_next
 @pytest.mark.parametrize("header,why", [
     (struct.pack(">HHHB", 1, 0, 0xFFFF, 1), "frame length field 65535"),
     (struct.pack(">HHHB", 1, 0, 300, 1), "frame length field 300"),
+    (struct.pack(">HHHB", 1, 0, 266, 1), "frame length field 266"),
     (struct.pack(">HHHB", 1, 0, 1, 1), "frame length field 1"),
     (struct.pack(">HHHB", 1, 7, 6, 1) + pdu(3, L2, 1), "protocol id 7"),
 ])
@@ -189,6 +220,26 @@ def test_a_frame_that_cannot_be_resynchronised_closes_that_connection_alone(lock
         assert bad.closed_by_peer()
         assert other.request(pdu(3, L2, 1))[:2] == b"\x03\x02"
         lockstep_server.wait_for(why, start=start)
+
+
+@pytest.mark.parametrize("bad", [dict(pid=1), dict(length=300)])
+def test_requests_before_a_bad_header_in_the_same_segment_are_answered_before_the_connection_closes(
+        lockstep_server, bad):
+    with Raw(lockstep_server.port) as c:
+        c.send(c.frame(pdu(3, L2, 1), tid=1) + c.frame(pdu(4, 0, 2), tid=2) + c.frame(pdu(3, L2, 1), tid=3, **bad))
+        assert [c.response()[0] for _ in range(2)] == [1, 2]
+        assert c.closed_by_peer()
+
+
+@pytest.mark.parametrize("request_pdu", [
+    bytes([16]) + struct.pack(">HHB", L2, 124, 248) + bytes(248),  # MBAP length 255
+    bytes([16]) + struct.pack(">HHB", L2, 127, 254) + bytes(254),  # 261
+    bytes([23]) + struct.pack(">HHHHB", L2, 1, L2, 127, 254) + bytes(254),  # 265, the longest we frame
+    bytes([15]) + struct.pack(">HHB", 16, 2000, 250) + bytes(250),  # 257
+])
+def test_a_write_just_over_the_quantity_limit_gets_illegal_data_value_not_a_dropped_connection(raw, request_pdu):
+    assert raw.request(request_pdu) == exception(request_pdu[0], 0x03)
+    assert read_hr(raw, L2)  # the same connection still works
 
 
 def test_a_client_that_vanishes_mid_frame_leaves_the_server_and_the_simulation_going(lockstep_server):

@@ -2,14 +2,22 @@
 
 `TwinBridge.step()` is what a runner (`twin.pacing`) calls once per simulation step: it applies the
 writes queued since the last step (each request's writes together, in arrival order), steps the twin
-once, and publishes new register images. The server only ever reads published images, so a read sees
-the state after the last completed step, and a write takes effect at the next step.
+once, and publishes new register images. The server only ever reads published images, so a read of an
+output sees the state after the last completed step, and a write takes effect at the next step.
+
+Inputs (coils, holding registers) are what the client wrote: an accepted write is copied into their
+images at once (`_show_written`), so reading it back gives the written value before the step applies
+it. A step's publish cannot undo that: the runner and the server share one event loop, so no write
+arrives between a step taking the queue and its publish, and every write queued before the step has
+been applied to the twin by then. `publish` still lays the writes still queued over what it reads
+from the twin, so the rule does not depend on who calls it when.
 
 The twin is anything with `signals`, `read(name)`, `write(name, value)`, `step()`, `step_count`,
 `time` and `dt` (the `twin.core.Twin` contract). The bridge imports neither sockets nor clocks.
 """
 from __future__ import annotations
 
+import dataclasses
 import struct
 import sys
 import traceback
@@ -61,7 +69,28 @@ class TwinBridge:
                 self.runner.request(int(value))
         if signals:
             self._queue.append(signals)
+            self._show_written(signals)
         return 0
+
+    def _show_written(self, changes: Sequence[tuple[Entry, object]]) -> None:
+        """Copy accepted writes into the coil and holding-register images (as the next publish will show them)."""
+        coils = holding = None
+        for entry, value in changes:
+            if entry.table == COIL:
+                if coils is None:
+                    coils = bytearray(self.images.coils)
+                coils[entry.address] = 1 if value else 0
+            elif entry.table == HOLDING_REGISTER:
+                if holding is None:
+                    holding = bytearray(self.images.holding)
+                struct.pack_into(f">{entry.count}H", holding, 2 * entry.address, *entry.encode(value))
+        changed = {}
+        if coils is not None:
+            changed["coils"] = bytes(coils)
+        if holding is not None:
+            changed["holding"] = bytes(holding)
+        if changed:
+            self.images = dataclasses.replace(self.images, **changed)
 
     def live_holding(self, address: int) -> int | None:
         if self._advance is not None and address == self._advance.address:
@@ -117,3 +146,5 @@ class TwinBridge:
                     words[e.address:e.end] = e.encode(v)
                 images[table] = struct.pack(f">{size}H", *words)
         self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
+        for batch in self._queue:  # written but not yet applied (empty after a step): still reads as written
+            self._show_written(batch)

@@ -3,8 +3,9 @@
     twin serve STATION [--host 127.0.0.1] [--port 5020] [--unit-id 1] [--realtime | --lockstep] [--speed X]
     twin map STATION [--format json|csv|md]
 
-`serve` logs to stderr: one line when listening (with the bound port, so `--port 0` is usable), one per
-client connect and disconnect, one when stopped. It stops cleanly on Ctrl-C or SIGTERM (exit 0).
+`serve` logs to stderr: one line when it starts loading the station, one when listening (with the bound
+port, so `--port 0` is usable), one per client connect and disconnect, one when stopped. It stops cleanly
+on Ctrl-C or SIGTERM (exit 0); one that comes while the station is loading stops it once it is loaded.
 """
 from __future__ import annotations
 
@@ -13,6 +14,10 @@ import asyncio
 import signal
 import sys
 from pathlib import Path
+
+
+def _log(text: str) -> None:
+    print(f"twin serve: {text}", file=sys.stderr, flush=True)
 
 
 def open_twin(station, on_event=None):
@@ -25,8 +30,6 @@ def open_twin(station, on_event=None):
 
 def controller_log(event: dict) -> None:
     """What the robot controller says, in the server's log: TPWrite lines, a runtime error, the end."""
-    from .bridge import _log
-
     kind, t = event.get("type"), event.get("t", 0.0)
     if kind == "print":
         _log(f"[t={t:.3f} s] robot: {event['text']}")
@@ -43,6 +46,13 @@ def _positive(text: str) -> float:
     return v
 
 
+def _port(text: str) -> int:
+    v = int(text)
+    if not 0 <= v <= 0xFFFF:
+        raise argparse.ArgumentTypeError(f"a TCP port is 0..65535, not {text}")
+    return v
+
+
 def _unit(text: str) -> int:
     v = int(text)
     if not 0 <= v <= 255:
@@ -55,7 +65,7 @@ def add_commands(subparsers) -> None:
                               description="Run a station and serve every signal on Modbus/TCP (map: `twin map`).")
     p.add_argument("station", help="a station folder or station.toml")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback only)")
-    p.add_argument("--port", type=int, default=5020, help="TCP port (default 5020; 0 = any free port, printed)")
+    p.add_argument("--port", type=_port, default=5020, help="TCP port (default 5020; 0 = any free port, printed)")
     p.add_argument("--unit-id", type=_unit, default=1, help="Modbus unit id answered (default 1; 0 and 255 too)")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--realtime", dest="lockstep", action="store_false",
@@ -83,16 +93,79 @@ def cmd_map(args) -> int:
     return 0
 
 
-def cmd_serve(args) -> int:
-    from .register_map import build_register_map
+class StopRequested(BaseException):
+    """A second SIGINT or SIGTERM while the station is loading: cut the loading short. A BaseException,
+    so that no `except Exception` on the way out of the loaders swallows it."""
 
-    twin = open_twin(args.station, on_event=controller_log)
+
+class _StartUpSignals:
+    """SIGINT/SIGTERM before the event loop takes them over (loading the station takes a while).
+
+    The first one is remembered (and sets `stop`): the server stops cleanly as soon as the station is
+    loaded. It does not raise, for an exception raised there lands in whatever is loading: numpy's
+    import turns it into an ImportError, which pybullet prints. A second one cuts the loading short
+    (StopRequested). Once stopping, signals are ignored, so none can interrupt the shutdown."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self, stop: asyncio.Event):
+        self.stop = stop
+        self.received: int | None = None
+        self.stopping = False
+        self.previous = {}
+        try:
+            for sig in self.SIGNALS:
+                self.previous[sig] = signal.signal(sig, self._on_signal)
+        except ValueError:  # not the main thread: signals are the caller's business
+            pass
+
+    def _on_signal(self, signum, frame) -> None:
+        if self.stopping:
+            return
+        if self.received is None:
+            self.received = signum
+            self.stop.set()
+            return
+        self.stopping = True
+        raise StopRequested(signum)
+
+    def ignore(self) -> None:
+        """Stopping: the event loop has put back the default handlers; take the signals again."""
+        self.stopping = True
+        for sig in self.previous:
+            signal.signal(sig, self._on_signal)
+
+    def restore(self) -> None:
+        for sig, handler in self.previous.items():
+            signal.signal(sig, handler)
+
+
+def cmd_serve(args) -> int:
+    stop = asyncio.Event()
+    signals = _StartUpSignals(stop)  # first thing: loading the station (pybullet) takes a while
+    twin = None
     try:
+        from .register_map import build_register_map
+
+        _log(f"loading station {args.station}")
+        twin = open_twin(args.station, on_event=controller_log)
         rmap = build_register_map(twin.signals, twin.station.name)
+        if signals.received is not None:
+            raise StopRequested(signals.received)
         return asyncio.run(serve(twin, rmap, host=args.host, port=args.port, unit_id=args.unit_id,
-                                 lockstep=args.lockstep, speed=args.speed, frame_timeout=args.frame_timeout))
+                                 lockstep=args.lockstep, speed=args.speed, frame_timeout=args.frame_timeout, stop=stop))
+    except BaseException:
+        if signals.received is None:
+            raise
+        _log(f"stopped by {signal.Signals(signals.received).name} while starting")
+        return 0
     finally:
-        twin.close()
+        signals.ignore()
+        try:
+            if twin is not None:
+                twin.close()
+        finally:
+            signals.restore()
 
 
 async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1, lockstep: bool = False,
@@ -100,7 +173,7 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
     """Serve `twin` with `rmap` until `stop` is set (or SIGINT/SIGTERM). Returns the exit code."""
     from twin.pacing import LockstepRunner, RealtimeRunner
 
-    from .bridge import TwinBridge, _log
+    from .bridge import TwinBridge
     from .server import ModbusServer
 
     loop = asyncio.get_running_loop()

@@ -258,7 +258,8 @@ class RegisterMap:
                  "32-bit values take two registers, big-endian, **high word first**. Value = counts x scale,",
                  "in the unit shown (lengths in mm, angles in degrees, forces in N). Bits: 1 = true.",
                  f"Addresses 0 to {RESERVED - 1} of each table belong to the simulator; station signals start at {RESERVED}.",
-                 "Writes take effect at the next simulation step; reads show the state after the last completed step.",
+                 "Writes take effect at the next simulation step; coils and holding registers read back what was",
+                 "written at once, discrete inputs and input registers show the state after the last completed step.",
                  "Out of range: exception 03, nothing changes. Address not in the map: exception 02.", ""]
         names = {COIL: "Coils (read/write bits, FC 1, 5, 15)",
                  DISCRETE_INPUT: "Discrete inputs (read-only bits, FC 2)",

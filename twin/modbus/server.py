@@ -2,8 +2,9 @@
 
 The server answers from register images (`Images`) that its backend publishes after each completed
 simulation step, and hands validated writes to the backend (`Backend.submit`), which applies them at
-the start of the next step. So a read always sees one completed step, and a write takes effect at the
-next step.
+the start of the next step and shows them in the coil and holding-register images at once. So a read
+of an output always sees one completed step, a read of an input what was last written, and a write
+takes effect at the next step.
 
 What is taken from pymodbus, and what is not
 --------------------------------------------
@@ -23,12 +24,18 @@ pymodbus `ModbusTcpServer` on `SimDevice` (the v4 datastore). Tested with pymodb
 
 Wire behaviour
 --------------
-- MBAP header: 7 bytes; a protocol id other than 0, or a length field outside 2..254 (unit id plus a
-  PDU of at most 253 bytes) cannot be resynchronised: that connection is closed (and logged); other
-  connections are not affected.
+- MBAP header: 7 bytes; a protocol id other than 0, or a length field outside 2..265, cannot be
+  resynchronised: that connection is closed (and logged) once the requests before it in the stream
+  are answered; other connections are not affected. 265 is the unit id plus the longest PDU a
+  supported request can describe (function 23 writing 127 registers, a byte count of 254), so a
+  request that is merely over its function's quantity limit (e.g. function 16 with 124 registers,
+  length 255) is framed and answered with exception 03 rather than dropped.
 - Requests on one connection are handled one after another and answered in order, however many are
-  pipelined before the first reply. A half frame that is not completed within `frame_timeout` seconds
-  closes that connection (the next request is never glued onto it).
+  pipelined before the first reply. A connection gets at most `requests_per_turn` requests answered
+  per turn of the event loop; with more pipelined, it stops reading and goes on at the next turn, so
+  one flooding client cannot starve the simulation runner or the other clients. A half frame that is
+  not completed within `frame_timeout` seconds closes that connection (the next request is never
+  glued onto it).
 - Unit id: the server answers its `unit_id`, and 0 and 255 (which the TCP implementation guide uses for
   "this device"). Any other unit id gets exception 0B (gateway target device failed to respond).
 - Exceptions: the response's function code is the request's with the high bit set. An unknown function
@@ -38,6 +45,8 @@ Wire behaviour
   write that covers only part of a 32-bit value); a value outside the signal's range gets 03 and
   changes nothing (a multi-register write is all or nothing); a write while the simulation is faulted
   gets 04.
+- An accepted write shows at once when its coils or holding registers are read back (function 23
+  writes, then reads); the twin applies it at the next step.
 """
 from __future__ import annotations
 
@@ -57,7 +66,8 @@ GATEWAY_TARGET_FAILED = 0x0B
 MAX_READ_BITS, MAX_READ_REGISTERS = 2000, 125
 MAX_WRITE_BITS, MAX_WRITE_REGISTERS = 1968, 123
 MAX_RW_READ, MAX_RW_WRITE = 125, 121
-MAX_PDU = 253
+MAX_LENGTH = 1 + 10 + 2 * 127  # MBAP length: unit id + function 23 writing 127 registers (byte count 254)
+REQUESTS_PER_TURN = 64  # pipelined requests answered per connection per event-loop turn
 
 _HDR = struct.Struct(">HHHB")
 _AQ = struct.Struct(">HH")
@@ -79,8 +89,8 @@ class Backend(Protocol):
     images: Images
 
     def submit(self, changes: Sequence[tuple[Entry, object]]) -> int:
-        """Queue writes (entry, value in SI units) for the next step, all or nothing.
-        Returns 0, or a Modbus exception code (nothing queued)."""
+        """Queue writes (entry, value in SI units) for the next step, all or nothing, and show them in
+        the coil / holding-register images at once. Returns 0, or a Modbus exception code (nothing queued)."""
 
     live_addresses: frozenset[int]  # holding registers whose value is live (read through live_holding)
 
@@ -128,10 +138,11 @@ class ModbusServer:
     """Serve `rmap` from `backend` over Modbus/TCP (see the module docstring)."""
 
     def __init__(self, rmap: RegisterMap, backend: Backend, *, unit_id: int = 1, frame_timeout: float = 1.0,
-                 log: Callable[[str], None] = _log):
+                 requests_per_turn: int = REQUESTS_PER_TURN, log: Callable[[str], None] = _log):
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
         self.units = {unit_id, 0, 255}
         self.frame_timeout = frame_timeout
+        self.requests_per_turn = requests_per_turn
         self.log = log
         self.tables = {t: _Table(rmap, t) for t in TABLES}
         self.connections: set[_Connection] = set()
@@ -271,6 +282,7 @@ class ModbusServer:
             return ILLEGAL_DATA_VALUE
         if not self.tables[HOLDING_REGISTER].readable(raddr, rcount):
             return ILLEGAL_DATA_ADDRESS
+        # The spec's order: the write first, then the read (which sees the write).
         code = self._write(HOLDING_REGISTER, waddr, struct.unpack_from(f">{wcount}H", pdu, 10))
         if code:
             return code
@@ -282,13 +294,19 @@ class ModbusServer:
 
 
 class _Connection(asyncio.Protocol):
-    """One client: MBAP framing, requests answered in order, a timeout on half frames."""
+    """One client: MBAP framing, requests answered in order, a fair share of the loop, a timeout on half frames.
+
+    Reading stops (so TCP pushes back on the client) while the client does not read its answers
+    (`pause_writing`) and while complete requests wait for the next turn of the loop (`_later`)."""
 
     def __init__(self, server: ModbusServer):
         self.server = server
         self.buf = bytearray()
         self.transport: asyncio.Transport | None = None
         self.timer: asyncio.TimerHandle | None = None
+        self._later: asyncio.Handle | None = None  # the next turn's share of pipelined requests
+        self.writing_paused = False
+        self.closed = False
         self.peer = "?"
         self.reason = ""
 
@@ -306,53 +324,94 @@ class _Connection(asyncio.Protocol):
         self.server.log(f"client {self.peer} connected ({len(self.server.connections)} connected)")
 
     def connection_lost(self, exc) -> None:
-        if self.timer is not None:
-            self.timer.cancel()
-            self.timer = None
+        self.closed = True
+        self._stop_timer()
+        if self._later is not None:
+            self._later.cancel()
+            self._later = None
         self.server.connections.discard(self)
         reason = self.reason or (f"error: {exc}" if exc else "closed by the client")
         self.server.log(f"client {self.peer} disconnected ({reason}; {len(self.server.connections)} connected)")
 
     def close(self, reason: str) -> None:
+        """Drop the connection now (anything not yet sent is lost)."""
         if not self.reason:
             self.reason = reason
+        self.closed = True
         if self.transport is not None:
             self.transport.abort()
 
+    def _close_after_answers(self, reason: str) -> None:
+        """Close once the answers already written are sent; abort if the client will not take them."""
+        self.reason = self.reason or reason
+        self.closed = True
+        self.transport.close()
+        asyncio.get_running_loop().call_later(self.server.frame_timeout, self.transport.abort)
+
     def pause_writing(self) -> None:  # the client does not read its answers: stop reading its requests
+        self.writing_paused = True
+        self._stop_timer()  # it cannot complete a half frame while we do not read
         self.transport.pause_reading()
 
     def resume_writing(self) -> None:
-        self.transport.resume_reading()
+        self.writing_paused = False
+        if self._later is None and not self.closed:
+            self._later = asyncio.get_running_loop().call_soon(self._next_turn)
 
     def data_received(self, data: bytes) -> None:
+        self.buf += data
+        if self._later is None and not self.writing_paused:
+            self._answer()
+
+    def _next_turn(self) -> None:
+        self._later = None
+        if not self.closed and not self.writing_paused:
+            self._answer()
+
+    def _answer(self) -> None:
+        """Answer the complete requests at the front of the buffer, at most `requests_per_turn` of them."""
         buf = self.buf
-        buf += data
         out = []
         pos, n = 0, len(buf)
         handle = self.server.handle
-        while n - pos >= 7:
+        budget = self.server.requests_per_turn
+        bad = ""
+        while budget and n - pos >= 7:
             tid, pid, length, unit = _HDR.unpack_from(buf, pos)
             if pid != 0:
-                self.close(f"protocol id {pid}, not 0 (Modbus)")
-                return
-            if not 2 <= length <= MAX_PDU + 1:
-                self.close(f"frame length field {length} outside 2..254")
-                return
+                bad = f"protocol id {pid}, not 0 (Modbus)"
+                break
+            if not 2 <= length <= MAX_LENGTH:
+                bad = f"frame length field {length} outside 2..{MAX_LENGTH}"
+                break
             if n - pos < 6 + length:
                 break
             response = handle(unit, bytes(buf[pos + 7:pos + 6 + length]))
             out.append(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
             pos += 6 + length
+            budget -= 1
         if pos:
             del buf[:pos]
-            if self.timer is not None:
-                self.timer.cancel()
-                self.timer = None
+            self._stop_timer()
         if out:
-            self.transport.write(b"".join(out))
-        if buf and self.timer is None:
-            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+            self.transport.write(b"".join(out))  # may call pause_writing
+        if bad:
+            self._close_after_answers(bad)
+            return
+        if not budget and len(buf) >= 7:  # more may be waiting: the loop's other work first
+            self.transport.pause_reading()
+            if not self.writing_paused:
+                self._later = asyncio.get_running_loop().call_soon(self._next_turn)
+            return
+        if not self.writing_paused:
+            self.transport.resume_reading()
+            if buf and self.timer is None:
+                self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+
+    def _stop_timer(self) -> None:
+        if self.timer is not None:
+            self.timer.cancel()
+            self.timer = None
 
     def _stalled(self) -> None:
         self.timer = None
