@@ -46,6 +46,22 @@ class HostError(ExecError):
         super().__init__(f"{message} ({errname})", None, ERRORS.get(errname, 0), errname)
 
 
+def _pose(target: Record):
+    from twin.core.geometry import Pose
+
+    return Pose(*_pose_of(target))
+
+
+def _tframe(tool: Record):
+    """A tooldata's TCP in the flange frame (a Pose in m)."""
+    return _pose(tool.fields["tframe"])
+
+
+def _wobj_frame(wobj: Record):
+    """A wobjdata's object frame in the world: uframe x oframe (a Pose in m)."""
+    return _pose(wobj.fields["uframe"]) * _pose(wobj.fields["oframe"])
+
+
 def _pose_of(target: Record) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
     """A robtarget or pose (mm, quaternion q1..q4 with q1 = w) as a position in m and an xyzw quaternion."""
     trans, rot = target.fields["trans"], target.fields["rot"]
@@ -66,6 +82,7 @@ class TwinHost:
         self.outputs: dict[str, float] = {s.name: 0.0 for s in spec.io if s.drives}
         self.printed: list[str] = []
         self._motion = 0
+        self._active: tuple[Record | None, Record | None] = (None, None)  # tooldata, wobjdata of the last motion
 
     # -- signals --------------------------------------------------------------------------------------
     def signals(self) -> Sequence[SignalInfo]:
@@ -96,38 +113,39 @@ class TwinHost:
 
     # -- robot ----------------------------------------------------------------------------------------
     def start_motion(self, request: MotionRequest) -> object:
+        """Drive the robot: the target is for the program's tooldata (its tframe) in its wobjdata."""
         twin = self.twin
         speed = request.speed.fields
         v_tcp = float(speed["v_tcp"]) / 1000.0
         v_ori = math.radians(float(speed["v_ori"]))
         name = request.target_name or request.instr
+        tool = _tframe(request.tool)
         try:
             if request.instr == "MoveAbsJ":
                 q = [math.radians(float(v)) for v in request.target.fields["robax"].values()]
                 twin.move("MoveAbsJ", q, v_tcp, v_ori=v_ori, name=name)
             else:
-                wobj = request.wobj.fields
-                target = self._in_world(_pose_of(request.target), wobj)
-                via = self._in_world(_pose_of(request.via), wobj) if request.via is not None else None
-                twin.move(request.instr, target, v_tcp, v_ori=v_ori, via=via, name=name)
+                frame = _wobj_frame(request.wobj)
+                target = frame * _pose(request.target)
+                via = frame * _pose(request.via) if request.via is not None else None
+                twin.move(request.instr, target, v_tcp, v_ori=v_ori, via=via, name=name, tool=tool)
         except MotionError as exc:
             raise HostError(str(exc), "ERR_ROBLIMIT") from None
+        self._active = (request.tool, request.wobj)
         self._motion += 1
         return self._motion
-
-    def _in_world(self, pose, wobj: dict):
-        from twin.core.geometry import Pose
-
-        frame = Pose.identity()
-        for key in ("uframe", "oframe"):
-            frame = frame * Pose(*_pose_of(wobj[key]))
-        return frame * Pose(*pose)
 
     def motion_done(self, handle: object) -> bool:
         return handle != self._motion or not self.twin.robot_busy
 
     def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
-        pose = self.twin.tcp_pose()
+        """CRobT: the TCP of `tool` in `wobj`; without them, those of the last motion (the active ones), or
+        before any motion the station's tcp in the world (wobj0)."""
+        active_tool, active_wobj = self._active
+        tool, wobj = tool or active_tool, wobj or active_wobj
+        pose = self.twin.tcp_pose(_tframe(tool) if tool is not None else None)
+        if wobj is not None:
+            pose = _wobj_frame(wobj).inverse() * pose
         x, y, z = (float(v) * 1000.0 for v in pose.position)
         qx, qy, qz, w = (float(v) for v in pose.orientation)
         return record("robtarget", [x, y, z], [w, qx, qy, qz], [0, 0, 0, 0], [9e9] * 6)

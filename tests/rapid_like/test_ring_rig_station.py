@@ -96,3 +96,35 @@ def test_the_station_binding_gives_a_busy_loop_a_small_budget_per_step():
 
     with open_cell(RIG) as twin:
         assert twin.controller.interp.loop_budget == STATION_LOOP_BUDGET < DEFAULT_LOOP_BUDGET
+
+
+TOOL_AND_WOBJ = """MODULE ToolWobj
+  PERS tooldata tLong := [TRUE,[[0,0,450],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
+  PERS wobjdata wPallet := [FALSE,TRUE,"",[[1600,-800,150],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];
+  CONST robtarget pAbove := [[0,0,500],[0,1,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PERS robtarget pHere := [[0,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PERS robtarget pWorld := [[0,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PROC main()
+    MoveL pAbove,v1000,fine,tLong\\WObj:=wPallet;
+    pHere := CRobT();
+    pWorld := CRobT(\\Tool:=tool0\\WObj:=wobj0);
+  ENDPROC
+ENDMODULE
+"""
+
+
+def test_motions_and_crobt_use_the_programs_tooldata_and_wobjdata(tmp_path):
+    station = copy_rig(tmp_path)
+    (station / "tool_wobj.mod").write_text(TOOL_AND_WOBJ)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace('program = "ring_rig.mod"', 'program = "tool_wobj.mod"')
+                    .replace('entry = "Init"', 'entry = "main"'))
+    with open_cell(station) as twin:
+        run_until(twin, lambda: twin.controller.state == "completed", 20.0)
+        # the long tool's TCP (450 mm out) is 500 mm above the pallet's top: the station's tcp (350 mm) 100 mm higher
+        assert twin.tcp_pose().position == pytest.approx((1.6, -0.8, 0.15 + 0.5 + 0.1), abs=0.001)
+        data = twin.controller.interp.globals
+        here = data["phere"].value.fields["trans"]
+        assert [float(here.fields[k]) for k in "xyz"] == pytest.approx([0, 0, 500], abs=0.5)  # in wPallet, for tLong
+        world = data["pworld"].value.fields["trans"]
+        assert [float(world.fields[k]) for k in "xyz"] == pytest.approx([1600, -800, 150 + 500 + 450], abs=0.5)  # the flange

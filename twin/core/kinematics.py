@@ -11,6 +11,8 @@ give the same outputs, bit for bit.
 """
 from __future__ import annotations
 
+import copy
+
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -134,6 +136,12 @@ class ArmKinematics:
     def flange_pose(self, q: Iterable[float]) -> Pose:
         self._set(self._as_q(q))
         return self._flange()
+
+    def with_tool(self, tool: Pose) -> "ArmKinematics":
+        """The same arm (and connection) with another TCP, e.g. a robot program's own tooldata."""
+        other = copy.copy(self)
+        other.tool, other._tool_inv = tool, tool.inverse()
+        return other
 
     def fk(self, q: Iterable[float]) -> Pose:
         """The TCP pose (flange x tool) in the world for joint positions q (rad)."""

@@ -267,13 +267,14 @@ class Twin:
         return Pose.from_xyz_rpy(placement.xyz, placement.rpy)
 
     def move(self, instr: str, target, speed: float = 1.0, *, v_ori: float | None = None, via=None,
-             name: str | None = None) -> None:
+             name: str | None = None, tool=None) -> None:
         """Start a motion from where the robot is now; it runs over the next steps (see `robot_busy`).
 
         `instr` is MoveJ, MoveL, MoveC (through `via`) or MoveAbsJ (target: joint angles in rad). A
         target is a Pose or the name of a station target; `speed` is the TCP speed in m/s, `v_ori` the
-        reorientation speed in rad/s. The whole path is checked before the robot moves: a target it
-        cannot reach raises MotionError naming the target.
+        reorientation speed in rad/s. `tool`: the TCP in the flange frame for this motion (a Pose; default
+        the station's `tcp`). The whole path is checked before the robot moves: a target it cannot reach
+        raises MotionError naming the target.
         """
         from . import motion
 
@@ -287,14 +288,15 @@ class Twin:
         name = name or instr
         speed_spec = motion.Speed(v_tcp=speed, v_ori=v_ori) if v_ori is not None else motion.Speed(v_tcp=speed)
         q0 = self.robot.q
+        kin = self.kinematics if tool is None else self.kinematics.with_tool(tool)
         if instr == "MoveJ":
-            traj = motion.movej(self.kinematics, q0, target, None, speed_spec, name)
+            traj = motion.movej(kin, q0, target, None, speed_spec, name)
         elif instr == "MoveL":
-            traj = motion.movel(self.kinematics, q0, target, speed_spec, name)
+            traj = motion.movel(kin, q0, target, speed_spec, name)
         elif instr == "MoveC":
-            traj = motion.movec(self.kinematics, q0, via, target, speed_spec, name)
+            traj = motion.movec(kin, q0, via, target, speed_spec, name)
         elif instr == "MoveAbsJ":
-            traj = motion.moveabsj(q0, target, speed_spec, self.kinematics.limits, name)
+            traj = motion.moveabsj(q0, target, speed_spec, kin.limits, name)
         else:
             raise MotionError(name, f"unknown motion instruction {instr!r}")
         self.robot.start(traj, self.time)
@@ -308,8 +310,10 @@ class Twin:
     def robot_q(self):
         return self.robot.q
 
-    def tcp_pose(self):
-        return self.robot.tcp_pose()
+    def tcp_pose(self, tool=None):
+        """The TCP in the world: of the station's `tcp`, or of `tool` (a Pose in the flange frame)."""
+        pose = self.robot.tcp_pose()
+        return pose if tool is None else pose * self.kinematics.tool.inverse() * tool
 
     def run_motion(self, instr: str, target, speed: float = 1.0, *, max_time: float = 120.0, **kw) -> None:
         """Start a motion and step until the robot is in position."""
