@@ -11,6 +11,8 @@ Two small adapters, one per side of the controller:
   step (before the gripper and the robot act, so a `SetAO` takes effect in the same step), and adds the
   controller's signals to the twin's signal table, so the Modbus server publishes them. Memory signals
   are writable from outside (like RobotStudio's I/O simulator); wired ones are read-only mirrors.
+  After them come the program's own: `rapid.start` / `rapid.stop` (rising edges restart the program from
+  its entry routine or stop it), `rapid.running`, `rapid.error` and `rapid.line` (where it waits).
 
 `attach_controller(twin)` does the wiring for a twin whose station has a `[controller]`.
 
@@ -36,6 +38,8 @@ from .host import MotionRequest, SignalInfo
 from .values import Record, record
 
 SIGNAL_TYPE = {"DI": BOOL, "DO": BOOL, "AI": FLOAT, "AO": FLOAT, "GI": INT, "GO": INT}
+# The program's own signals, after the configured I/O: start and stop it from outside, see how it runs.
+START, STOP, RUNNING, ERROR, LINE = "rapid.start", "rapid.stop", "rapid.running", "rapid.error", "rapid.line"
 STATION_LOOP_BUDGET = 200  # time-less loop iterations per simulation step (see the module docstring)
 
 
@@ -169,17 +173,47 @@ class ControllerDevice:
             what = (f"drives {sig.drives}" if sig.drives else f"reads {sig.source}" if sig.source else "controller memory")
             specs.append(SignalSpec(sig.name, OUTPUT if wired else INPUT, SIGNAL_TYPE[sig.type], sig.unit,
                                     description=f"robot controller {sig.type} {sig.name} ({what})", group="controller"))
+        specs += [
+            SignalSpec(START, INPUT, BOOL, group="controller",
+                       description="a rising edge (re)starts the RAPID program from its entry routine (VAR data anew, PERS kept)"),
+            SignalSpec(STOP, INPUT, BOOL, group="controller", description="a rising edge stops the RAPID program where it is"),
+            SignalSpec(RUNNING, OUTPUT, BOOL, group="controller", description="the RAPID program is running (or waiting)"),
+            SignalSpec(ERROR, OUTPUT, BOOL, group="controller",
+                       description="the RAPID program stopped on a runtime error (the server's log says where)"),
+            SignalSpec(LINE, OUTPUT, INT, min=0, max=65535, group="controller",
+                       description="the line of the program's module the robot controller waits at (0: none)"),
+        ]
         self.signals = tuple(specs)
+        self._requests = {START: False, STOP: False}  # as written
+        self._seen = dict(self._requests)  # as acted on
 
     def read(self, name: str):
+        if name in self._requests:
+            return self._requests[name]
+        state = self.controller.state
+        if name == RUNNING:
+            return state in ("running", "waiting")
+        if name == ERROR:
+            return state == "error"
+        if name == LINE:
+            wait = self.controller.wait
+            return wait.span.line if wait is not None and wait.span is not None and state == "waiting" else 0
         value = self.host.read_signal(name)
         kind = SIGNAL_TYPE[self.host.io[name].type]
         return bool(value) if kind == BOOL else int(value) if kind == INT else value
 
     def write(self, name: str, value) -> None:
-        self.host.memory[name] = float(value)
+        if name in self._requests:
+            self._requests[name] = bool(value)
+        else:
+            self.host.memory[name] = float(value)
 
     def before_step(self, twin) -> None:
+        """Act on program requests written since the last step (rising edges), then run the program."""
+        for name, value in self._requests.items():
+            if value and not self._seen[name]:
+                self.controller.stop() if name == STOP else self.controller.start()
+            self._seen[name] = value
         self.controller.tick(twin.time)
 
     def after_step(self, twin) -> None:

@@ -128,3 +128,19 @@ def test_motions_and_crobt_use_the_programs_tooldata_and_wobjdata(tmp_path):
         assert [float(here.fields[k]) for k in "xyz"] == pytest.approx([0, 0, 500], abs=0.5)  # in wPallet, for tLong
         world = data["pworld"].value.fields["trans"]
         assert [float(world.fields[k]) for k in "xyz"] == pytest.approx([1600, -800, 150 + 500 + 450], abs=0.5)  # the flange
+
+
+def test_the_program_can_be_stopped_and_started_again_from_its_entry_routine_by_signals():
+    with open_cell(RIG) as twin:
+        twin.step(10)
+        assert twin.read("rapid.running") and not twin.read("rapid.error")
+        assert twin.read("rapid.line") > 0  # waiting in Main (the WaitTime)
+        twin.write("rapid.stop", True)
+        twin.step(2)
+        assert not twin.read("rapid.running") and twin.read("rapid.line") == 0
+        twin.write("movePickOutside", True)
+        twin.step(100)
+        assert twin.read("movePickOutside") and twin.read("L2") == pytest.approx(0.35)  # nothing runs
+        twin.write("rapid.start", True)  # from Init again: it sees the request and picks the ring
+        run_until(twin, lambda: twin.read("doGripped"), 10.0)
+        assert twin.read("rapid.running") and not twin.read("movePickOutside")
