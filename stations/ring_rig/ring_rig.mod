@@ -28,7 +28,6 @@ MODULE RingRig
 
   PERS tooldata tcpGripper := [TRUE,[[0,0,350],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
 
-  CONST robtarget Target_Home := [[1000,0,1200],[0,1,0,0],[0,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   ! Right pallet: pick from outside, place from inside.
   CONST robtarget Target_AppPickOutside := [[1600,-800,580],[0,1,0,0],[-1,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST robtarget Target_PickOutside := [[1600,-800,180],[0,1,0,0],[-1,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
@@ -40,8 +39,9 @@ MODULE RingRig
   CONST robtarget Target_AppPickInside := [[1600,800,580],[0,1,0,0],[0,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
   CONST robtarget Target_PickInside := [[1600,800,180],[0,1,0,0],[0,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
 
+  ! Idle between paths: the robot stays where the last path left it (the cell starts with
+  ! the gripper around the ring on the right pallet).
   PROC Main()
-    MoveJ Target_Home,vmax,fine,tcpGripper\WObj:=wobj0;
     WaitTime 0.2;
   ENDPROC
 

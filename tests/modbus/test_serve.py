@@ -252,7 +252,7 @@ def test_the_ring_rig_serves_its_robot_axes_in_hundredths_of_a_degree():
         e = rmap["robot.j1"]
         words = ok(c.read_input_registers(e.address, count=12, device_id=UNIT)).registers
         axes = [rmap[f"robot.j{i}"].decode(words[2 * i - 2:2 * i]) for i in range(1, 7)]
-        assert axes == pytest.approx([0.0, -20.96, 42.09, 0.0, 68.87, -180.0], abs=0.05)  # home_deg, at Target_Home
+        assert axes == pytest.approx([-26.565, 42.642, 26.034, 0.0, 21.323, -206.565], abs=0.05)  # home_deg: at grip_right
         assert not ok(c.read_discrete_inputs(rmap["robot.busy"].address, count=1, device_id=UNIT)).bits[0]
         assert rmap["L2.actual"].decode(ok(c.read_input_registers(rmap["L2.actual"].address, count=1,
                                                                   device_id=UNIT)).registers) == pytest.approx(350, abs=1)
@@ -294,3 +294,19 @@ def test_a_signal_while_the_station_is_still_loading_stops_cleanly(sig):
 def test_a_second_signal_while_loading_cuts_the_loading_short():
     code, err = start_and_signal(signal.SIGTERM, signal.SIGINT)  # pending together: the lowest number first
     assert code == 0 and "stopped by SIGINT while starting" in err and "listening" not in err, err
+
+
+def test_the_ring_rig_grips_its_ring_by_register_writes_alone():
+    from twin.modbus.register_map import build_map
+
+    ring_rig = ROOT / "stations" / "ring_rig"
+    rmap = build_map(ring_rig)  # the cell starts with the open gripper around the ring on the right pallet
+    with ServerProcess(ring_rig, "--lockstep") as server, connect(server) as c:
+        fingers = rmap["L2"]
+        assert [rmap["L3"].address, rmap["L4"].address] == [fingers.address + 1, fingers.address + 2]
+        ok(c.write_registers(fingers.address, [30000, 30000, 30000], device_id=UNIT))  # 300 mm, 0.01 mm counts
+        advance(c, 200, [{"name": "sim.advance", "address": rmap["sim.advance"].address}])
+        assert ok(c.read_discrete_inputs(rmap["doGripped"].address, count=1, device_id=UNIT)).bits[0]
+        assert ok(c.read_input_registers(rmap["GrippedPart"].address, count=1, device_id=UNIT)).registers == [1]
+        words = ok(c.read_input_registers(rmap["L2.actual"].address, count=1, device_id=UNIT)).registers
+        assert rmap["L2.actual"].decode(words) == pytest.approx(320.0, abs=1.0)  # on the ring's 320 mm radius

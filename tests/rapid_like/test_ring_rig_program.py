@@ -110,11 +110,12 @@ def test_init_idles_in_main_and_starts_a_path_on_its_signal():
     changes = [SignalChange("movePickOutside", 1, 1.0), SignalChange("diGripped", 1, 2.0)]
     out = run_offline(module, SIGNALS, changes, entry="Init", max_time=3.0)
     assert out.reason == "time_limit"
-    homes = [e["t"] for e in out.events if e["type"] == "move" and e["to"]["trans"] == [1000, 0, 1200]]
-    assert homes[:5] == [0.0, 0.2, 0.4, 0.6, 0.8]  # Main: home and a short wait, over and over
+    moves = [(e["t"], e["instr"], e["to"]["trans"]) for e in out.events if e["type"] == "move"]
+    assert all(t >= 1.0 for t, _, _ in moves)  # Main only waits: the robot stays put until a path is asked for
     resets = [e for e in out.events if e.get("signal") == "movePickOutside"]
     assert resets == [{"t": 1.0, "type": "DO", "signal": "movePickOutside", "value": 0}]
-    assert 2.0 in homes  # back to Main once the ring is gripped
+    assert moves[0] == (1.0, "MoveJ", [1600, -800, 580])  # Path_PickOutside: to the approach at once
+    assert moves[-1] == (2.0, "MoveJ", [1600, -800, 580])  # and back up once the ring is gripped
 
 
 def test_rig_program_runs_with_the_cli(capsys):
