@@ -10,6 +10,7 @@ import sys
 BENCHMARKS = {
     "core": "bench.core_step",  # simulation steps per second, grip-check cost vs target count
     "modbus": "bench.modbus_latency",  # twin serve vs bare pymodbus: latency, throughput, late steps
+    "cell": "bench.cell",  # the full cycle: the PLC in process vs across Modbus/TCP, lockstep
 }
 
 

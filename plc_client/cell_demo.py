@@ -88,6 +88,8 @@ class CellDemo:
         self.remove_ring_at, self.scan_cycle = remove_ring_at, scan_cycle
         self.out = out or (lambda line: print(line, flush=True))
         self.now = 0.0  # simulated s, as last read from the server
+        self.scans = 0  # PLC scans of the last run
+        self.requests = 0  # Modbus requests the PLC sent in the last run
 
     def say(self, who: str, text: str) -> None:
         self.out(f"[t={self.now:8.3f} s] {who}: {text}")
@@ -148,6 +150,7 @@ class CellDemo:
                 break
         for line in log.lines():
             self.say("robot", line)
+        self.scans, self.requests = plc.scans, client.requests
         final = client.read("ring.present", "ring.x", "ring.y", "ring.z", "sim.time_ms")
         s.sim_time = final["sim.time_ms"] / 1000.0
         s.wall_time = time.perf_counter() - wall0

@@ -364,13 +364,13 @@ class TwinClient:
             return
         self.write({ADVANCE: steps})
         end = time.monotonic() + timeout
-        delay = 0.0002
-        while self.get(ADVANCE) != 0:
+        delay = 0.0001
+        while self.get(ADVANCE) != 0:  # each read is a round trip: poll briskly, a step takes about a ms
             if time.monotonic() > end:
                 raise PlcClientError(f"the server did not finish {steps} steps within {timeout:g} s "
                                      "(is it serving in lockstep mode?)")
             time.sleep(delay)
-            delay = min(delay * 2, 0.005)
+            delay = min(delay * 1.5, 0.001)
 
 
 class ClientIO(LocalSignals):

@@ -1,0 +1,70 @@
+"""The whole cell, one full automatic cycle in lockstep: the gripper PLC in process (no network) against the
+same PLC across Modbus/TCP (`twin serve` in a subprocess), side by side, so the price of the network is a
+ratio measured in one run.
+
+    python -m bench cell [--cycles N]
+
+Both runs use `stations/ring_rig_plc` (physics, the RAPID robot controller and the grip sequence) and the
+same PLC program (`plc_client.ring_rig.cell_sequence` and the demo's operator), scanning every 10 ms.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+STATION = ROOT / "stations" / "ring_rig_plc"
+
+
+def in_process(cycles: int) -> dict:
+    from plc_client import ring_rig
+    from plc_client.cell_demo import operator
+    from plc_client.scan import Combined, ScanCycle, TwinIO
+    from twin.cell import open_cell
+
+    t0 = time.perf_counter()
+    with open_cell(STATION) as twin:
+        load = time.perf_counter() - t0
+        plc = ScanCycle(TwinIO(twin), Combined(ring_rig.cell_sequence(), operator(cycles)))
+        t1 = time.perf_counter()
+        while twin.read("goCyclesDone") < cycles:
+            plc.scan()
+            if twin.time > 120 * cycles:
+                raise RuntimeError("the cycle did not end")
+        wall = time.perf_counter() - t1
+        return {"sim": twin.time, "wall": wall, "scans": plc.scans, "load": load, "requests": 0}
+
+
+def across_the_network(cycles: int) -> dict:
+    from plc_client.cell_demo import CellDemo
+
+    demo = CellDemo(STATION, cycles, out=lambda line: None)
+    t0 = time.perf_counter()
+    s = demo.run()
+    if s.cycles_done != cycles:
+        raise RuntimeError("the cycle did not end")
+    return {"sim": s.sim_time, "wall": sum(s.cycle_wall), "scans": demo.scans, "load": time.perf_counter() - t0 - s.wall_time,
+            "requests": demo.requests}
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="python -m bench cell", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cycles", type=int, default=1)
+    args = parser.parse_args(argv)
+    local = in_process(args.cycles)
+    remote = across_the_network(args.cycles)
+    print(f"ring_rig_plc, {args.cycles} full cycle(s) in lockstep, PLC scan 10 ms")
+    print(f"{'':34}{'in process':>12}{'over Modbus':>13}{'ratio':>8}")
+    rows = [
+        ("simulated s per cycle", local["sim"] / args.cycles, remote["sim"] / args.cycles, "{:.2f}"),
+        ("wall s per cycle", local["wall"] / args.cycles, remote["wall"] / args.cycles, "{:.2f}"),
+        ("x real time", local["sim"] / local["wall"], remote["sim"] / remote["wall"], "{:.1f}"),
+        ("PLC scans per wall s", local["scans"] / local["wall"], remote["scans"] / remote["wall"], "{:.0f}"),
+        ("Modbus requests per scan", 0.0, remote["requests"] / max(1, remote["scans"]), "{:.1f}"),
+    ]
+    for name, a, b, f in rows:
+        ratio = f"{b / a:.2f}" if a else ""
+        print(f"{name:34}{f.format(a):>12}{f.format(b):>13}{ratio:>8}")
+    print(f"(start-up: {local['load']:.1f} s to load the cell in process, {remote['load']:.1f} s for twin serve)")
+    return 0
