@@ -7,8 +7,8 @@ from .client import ClientIO, RegisterMap, Signal, TwinClient
 from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, PlcClientError,
                      SignalValueError, UnknownSignalError, ValueOutOfRangeError)
 from .grip_sequence import Fault, GripSequence, Handshake, Phase
-from .scan import InputImage, ScanCycle, TwinIO, plc_logic
+from .scan import Combined, InputImage, ScanCycle, TwinIO, plc_logic
 
-__all__ = ["TwinClient", "RegisterMap", "Signal", "ClientIO", "ScanCycle", "InputImage", "TwinIO", "plc_logic", "GripSequence",
+__all__ = ["TwinClient", "RegisterMap", "Signal", "ClientIO", "ScanCycle", "Combined", "InputImage", "TwinIO", "plc_logic", "GripSequence",
            "Handshake", "Phase", "Fault", "PlcClientError", "MapError", "UnknownSignalError", "SignalValueError",
            "ValueOutOfRangeError", "NotWritableError", "ModbusExceptionError", "ConnectionFailedError"]

@@ -46,3 +46,30 @@ def test_the_documented_missed_grip_check(plc_server, twin_client):
     plc.run_until(lambda i, s: s.phase in (Phase.HELD, Phase.FAULT_MISSED), timeout=10.0)
     assert io.get("grip_fault") and not io.get("gripped")
     assert twin_client.get("L2.actual") == pytest.approx(290.0, abs=0.5)  # stopped at the end of travel
+
+
+@pytest.mark.parametrize("plc_station", [BENCH.parents[3] / "stations" / "ring_rig_plc"])
+def test_the_documented_full_cycle_check(plc_server, twin_client):
+    from plc_client import Combined, ring_rig
+    from plc_client.cell_demo import operator
+
+    plc = ScanCycle(plc_server.io(twin_client), Combined(ring_rig.cell_sequence(), operator(cycles=1)))
+    plc.run_until(lambda inputs, state: twin_client.get("goCyclesDone") == 1, timeout=60.0)
+    assert twin_client.read("ring.x", "ring.y") == pytest.approx({"ring.x": 1600.0, "ring.y": -800.0}, abs=2.0)
+
+
+@pytest.mark.parametrize("plc_station", [BENCH])
+def test_a_part_taken_away_by_its_coil_makes_the_grip_miss(plc_server, twin_client):
+    from plc_client import Phase, ring_rig
+
+    seq = ring_rig.sequence()
+    io = plc_server.io(twin_client, local=seq.handshake_signals())
+    twin_client.write({"ring.present": False})  # the part is not there
+    plc = ScanCycle(io, seq)
+    io.set("grip_request", True)
+    plc.run_until(lambda i, s: s.phase in (Phase.HELD, Phase.FAULT_MISSED), timeout=10.0)
+    assert plc.state.phase is Phase.FAULT_MISSED and io.get("grip_fault")
+    twin_client.write({"ring.present": True})  # and back where the station put it
+    twin_client.advance(2)
+    assert twin_client.read("ring.x", "ring.y", "ring.z") == pytest.approx(
+        {"ring.x": 1600.0, "ring.y": -800.0, "ring.z": 180.0}, abs=0.5)
