@@ -9,7 +9,7 @@ touch time, signals or motion are executed by the evaluator; only their signatur
 from __future__ import annotations
 
 import math
-from decimal import ROUND_DOWN, ROUND_HALF_UP, Decimal
+from decimal import ROUND_DOWN, ROUND_HALF_UP, Decimal, localcontext
 
 from .nodes import Arg, Param
 from .values import Record, record
@@ -30,6 +30,8 @@ ERRORS = {
     "ERR_NORUNUNIT": 1012,
     "ERR_AO_LIM": 1013,
     "ERR_GO_LIM": 1014,
+    "ERR_ARGVALERR": 1015,
+    "ERR_NOTPRES": 1016,
 }
 ERR_NAMES = {v: k for k, v in ERRORS.items()}
 USER_ERRNO_BASE = 2000  # BookErrNo hands out numbers from here
@@ -66,6 +68,15 @@ def predefined_data() -> dict[str, tuple[str, object]]:
     data["wobj0"] = ("wobjdata", record("wobjdata", False, True, "", [[0, 0, 0], [1, 0, 0, 0]],
                                         [[0, 0, 0], [1, 0, 0, 0]]))
     data["load0"] = ("loaddata", record("loaddata", 0, [0, 0, 0], [1, 0, 0, 0], 0, 0, 0))
+    # stoppointdata for \Inpos (accepted, not simulated) and the stoppoint values of its `type`
+    for name, value in (("inpos", 1), ("stoptime", 2), ("fllwtime", 3)):
+        data[name] = ("num", float(value))
+    for p in (20, 50, 100):
+        data[f"inpos{p}"] = ("stoppointdata", record("stoppointdata", 1, True, [p, p, 0, 2], 0, 0, "", 0, 0))
+    for t in ("0_5", "1_0", "1_5"):
+        sec = float(t.replace("_", "."))
+        data[f"stoptime{t}"] = ("stoppointdata", record("stoppointdata", 2, False, [0, 0, 0, 0], sec, 0, "", 0, 0))
+        data[f"fllwtime{t}"] = ("stoppointdata", record("stoppointdata", 3, True, [0, 0, 0, 0], 0, sec, "", 0, 0))
     for name, num in ERRORS.items():
         data[name.lower()] = ("errnum", float(num))
     data["pi"] = ("num", math.pi)
@@ -96,7 +107,19 @@ def _sig(text: str) -> list[Param]:
     return params
 
 
-_MOVE_OPTS = r"\num V, \num T, \num Z, \switch Conc, \wobjdata WObj"
+# The motion instructions' arguments, as in the RAPID manual:
+#   MoveJ    [\Conc] ToPoint [\ID] Speed [\V]|[\T] Zone [\Z] [\Inpos] Tool [\WObj] [\TLoad]
+#   MoveL    [\Conc] ToPoint [\ID] Speed [\V]|[\T] Zone [\Z] [\Inpos] Tool [\WObj] [\Corr] [\TLoad]
+#   MoveC    [\Conc] CirPoint ToPoint [\ID] Speed [\V]|[\T] Zone [\Z] [\Inpos] Tool [\WObj] [\Corr] [\TLoad]
+#   MoveAbsJ [\Conc] ToJointPos [\ID] [\NoEOffs] Speed [\V]|[\T] Zone [\Z] [\Inpos] Tool [\WObj] [\TLoad]
+# Only \WObj and \V change what the host is asked to do (\V replaces the speeddata's v_tcp). The
+# others only matter on a real controller and are accepted and ignored: \Conc (the program still
+# waits for every motion: motions are not run concurrently with the next instructions), \ID
+# (MultiMove synchronisation), \T (the motion's time), \Z (the zone size: zones are not blended),
+# \Inpos (every motion ends in position anyway), \Corr (no path correction), \TLoad (the load
+# is not simulated) and \NoEOffs (no external axes).
+_MOVE_OPTS = (r"\switch Conc, \num ID, \num V | num T, \num Z, \stoppointdata Inpos, \wobjdata WObj, "
+              r"\loaddata TLoad")
 _INSTRUCTIONS = {
     "Incr": "INOUT num Name",
     "Decr": "INOUT num Name",
@@ -116,10 +139,11 @@ _INSTRUCTIONS = {
     "TPWrite": r"string String, \num Num | bool Bool | pos Pos | orient Orient",
     "TPErase": "",
     "MoveJ": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
-    "MoveL": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
+    "MoveL": "robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, \\switch Corr, " + _MOVE_OPTS,
     "MoveC": "robtarget CirPoint, robtarget ToPoint, speeddata Speed, zonedata Zone, tooldata Tool, "
-             + _MOVE_OPTS,
-    "MoveAbsJ": "jointtarget ToJointPos, speeddata Speed, zonedata Zone, tooldata Tool, " + _MOVE_OPTS,
+             "\\switch Corr, " + _MOVE_OPTS,
+    "MoveAbsJ": "jointtarget ToJointPos, speeddata Speed, zonedata Zone, tooldata Tool, \\switch NoEOffs, "
+                + _MOVE_OPTS,
     "Stop": r"\switch NoRegain",
     "Break": "",
     "ConfJ": r"\switch On, \switch Off",
@@ -229,8 +253,12 @@ def match_args(params: list[Param], args: list[Arg]) -> tuple[dict[str, Arg], st
 
 # ---- pure functions ------------------------------------------------------------------------------
 def _dec_round(x: float, dec: int, mode: str) -> float:
+    if not math.isfinite(x):
+        return x
     q = Decimal(1).scaleb(-int(dec))
-    return float(Decimal(repr(float(x))).quantize(q, rounding=mode))
+    with localcontext() as ctx:
+        ctx.prec = 1000  # enough digits for any float (1E300 with 2 decimals)
+        return float(Decimal(repr(float(x))).quantize(q, rounding=mode))
 
 
 def rapid_round(x: float, dec: float = 0) -> float:

@@ -1,11 +1,14 @@
 """Static check, run before anything executes: every name resolves (declared data, a routine, a
 predefined constant or a configured I/O signal), built-in and user routines get the right number
 and kinds of arguments, types agree where they can be known, constants and signals are not
-assigned, and RETRY/TRYNEXT appear only in ERROR handlers.
+assigned, RETRY/TRYNEXT appear only in ERROR handlers, and every FUNC has a RETURN somewhere (one
+that can still reach its ENDFUNC is the runtime error ERR_FNCNORET, at the ENDFUNC).
 
 RAPID does not declare signals; the controller's I/O configuration does. The checker gets that
 configuration (`signals`: lower-case name -> SignalInfo) so a misspelt signal is an error here, with
-its line and column, rather than a surprise in the middle of a cycle.
+its line and column, rather than a surprise in the middle of a cycle. A signal must have a name of
+its own: one that is also declared data, a routine, predefined data (reg1, v100, tool0, fine...),
+a built-in instruction or function, or a reserved word is an error here too.
 """
 from __future__ import annotations
 
@@ -16,7 +19,15 @@ from . import builtins as B
 from . import nodes as n
 from .errors import CheckError, Span
 from .host import SignalInfo
+from .tokens import KEYWORDS
 from .values import KNOWN_TYPES, RECORDS, SIGNAL_TYPES, a_, array_type, base_type, split_array_type
+
+
+# RAPID instructions that are deliberately left out of the subset, with what to do instead.
+_UNSUPPORTED = {
+    "callbyvar": "it calls a procedure by a name built at run time (late binding); call the "
+                 "procedure by its name, e.g. in a TEST on the number",
+}
 
 
 @dataclass
@@ -112,6 +123,7 @@ class Checker:
                 raise self.err(f"routine {r.name} is declared twice (first on line "
                                f"{self.routines[r.key].span.line})", r.span)
             self.routines[r.key] = r
+        self.check_signal_names()
         for d in self.module.data:
             dtype = self.decl_type(d, {})
             if d.key in self.globals or d.key in self.routines:
@@ -123,6 +135,25 @@ class Checker:
             self.globals[d.key] = Sym("data", dtype, d.storage, name=d.name)
         for r in self.module.routines:
             self.routine(r)
+
+    def check_signal_names(self) -> None:
+        """A configured signal's name must not be taken by anything else the program can name: a
+        routine of the program, predefined data (reg1, v100, tool0, fine, ERRNO...), a built-in
+        instruction or function, or a reserved word. (Declared data is checked with the data.)"""
+        for key, sig in self.signals.items():
+            what = f"the configured I/O signal {sig.name} ({sig.kind})"
+            if key in self.routines:
+                r = self.routines[key]
+                raise self.err(f"{r.kind} {r.name} has the name of {what}: rename one of them", r.span)
+            if key in self.predefined or key in B.PREDEFINED_VARS or key == "errno":
+                raise self.err(f"{what} has the name of the predefined data {_proper_data(key)}: rename the "
+                               f"signal", None)
+            if key in B.INSTRUCTIONS or key in B.FUNCTIONS:
+                kind = "instruction" if key in B.INSTRUCTIONS else "function"
+                raise self.err(f"{what} has the name of the built-in {kind} {_proper(key)}: rename the signal",
+                               None)
+            if key.upper() in KEYWORDS:
+                raise self.err(f"{what} is the reserved word {key.upper()}: rename the signal", None)
 
     def routine(self, r: n.Routine) -> None:
         scope: dict[str, Sym] = {}
@@ -151,6 +182,10 @@ class Checker:
         self.block(r.body, scope, in_handler=False)
         if r.error_handler is not None:
             self.block(r.error_handler, scope, in_handler=True)
+        if r.kind == "FUNC" and not any(isinstance(s, n.Return)
+                                        for s in _walk_stmts(r.body + (r.error_handler or []))):
+            raise self.err(f"FUNC {r.name} has no RETURN: a function must return its value with "
+                           f"RETURN value;", r.span)
 
     # ---- statements ----------------------------------------------------------------------------
     def block(self, stmts: list[n.Stmt], scope: dict[str, Sym], in_handler: bool) -> None:
@@ -270,6 +305,8 @@ class Checker:
             sym = self.lookup(s.name, scope)
             if sym is not None:
                 raise self.err(f"{s.name} is data, not an instruction (did you mean {s.name} := ...;?)", s.span)
+            if key in _UNSUPPORTED:
+                raise self.err(f"{s.name} is not supported by rapid_like: {_UNSUPPORTED[key]}", s.span)
             close = difflib.get_close_matches(key, list(self.routines) + list(B.INSTRUCTIONS), n=1)
             hint = ""
             if close:
@@ -525,6 +562,22 @@ class Checker:
         raise self.err(f"unknown function '{e.name}'{hint}", e.span)
 
 
+def _walk_stmts(stmts: list[n.Stmt]):
+    """Every statement of `stmts`, with those nested in IF, WHILE, FOR and TEST."""
+    for s in stmts:
+        yield s
+        if isinstance(s, n.If):
+            for _, body in s.branches:
+                yield from _walk_stmts(body)
+            yield from _walk_stmts(s.orelse or [])
+        elif isinstance(s, (n.While, n.For)):
+            yield from _walk_stmts(s.body)
+        elif isinstance(s, n.Test):
+            for _, body in s.cases:
+                yield from _walk_stmts(body)
+            yield from _walk_stmts(s.default or [])
+
+
 def _walk_labels(stmts: list[n.Stmt]):
     for s in stmts:
         if isinstance(s, n.Label):
@@ -543,3 +596,8 @@ def _walk_labels(stmts: list[n.Stmt]):
 
 def _proper(key: str) -> str:
     return B.PROPER_NAMES.get(key, key)
+
+
+def _proper_data(key: str) -> str:
+    """A predefined data name as the manual writes it: `reg1`, `v100`, `ERR_DIVZERO`, `ERRNO`, `pi`."""
+    return key.upper() if key.startswith("err") else key

@@ -8,8 +8,11 @@
 TPWrite lines go to stdout; with --trace every observable event is one JSON object per line.
 Errors go to stderr as `FILE:LINE:COL: error: message` with the source line and a caret.
 Without --max-time a run that is still going at 3600 simulated seconds ends there (time_limit),
-and a program waiting for a signal that nothing scheduled can change is an error. Exit status: 0 for a run that ends normally (completed, exit, stop, time_limit), 65 for a syntax
-or static error, 70 for a runtime error, 66 when the file cannot be read, 2 for a usage error.
+and a program waiting for a signal that nothing scheduled can change is an error. A PulseDO still
+running when the program ends (or stops, or fails) is completed by the I/O system: its edge is
+traced at its time and the end (or error) line comes last, at the time of that edge. Exit status:
+0 for a run that ends normally (completed, exit, stop, time_limit), 65 for a syntax or static
+error, 70 for a runtime error, 66 when the file cannot be read, 2 for a usage error.
 """
 from __future__ import annotations
 
@@ -103,7 +106,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--loop-budget", type=int, default=DEFAULT_LOOP_BUDGET, metavar="N",
                      help="loop iterations that consume no time run per tick before the loop waits for "
                           f"the next tick (default {DEFAULT_LOOP_BUDGET})")
-    run.add_argument("--trace", action="store_true", help="print every event as one JSON object per line")
+    run.add_argument("--trace", action="store_true",
+                     help="print every event as one JSON object per line; the last line is the end (or "
+                          "error) line, after the edges of any PulseDO still running when the program "
+                          "ended (the I/O system completes them), at the time of the last edge")
     return p
 
 

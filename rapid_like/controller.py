@@ -22,6 +22,10 @@ Events (`on_event(dict)`), each with `t` in seconds rounded to 1 us: output writ
 `{"type": "DO"|"AO"|"GO", "signal", "value"}`, `{"type": "print", "text"}`, motions
 `{"type": "move", "instr", "to", ["via"], "speed", "zone", "tool", "wobj"}`, and last
 `{"type": "end", "reason"}` or `{"type": "error", "line", "message"}` (the column is in `error`).
+Pulses outlive the program: a PulseDO (or SetDO \\SDelay) still running when the program ends,
+stops or fails is completed by the I/O system at its time, and the end or error event follows
+its last edge (so `t` never goes backwards and the end event is always the last one; the program
+itself ended earlier, at the time of its last own event). `state` and `error` change at once.
 
 A binding to a physics station implements `host.Host` (signals wired to the gripper, motions
 driving the robot, `motion_done` true when the robot is in position) and calls `tick(now)` once
@@ -129,9 +133,7 @@ class Controller:
         self.interp.apply_pulses()
         if self.state in (RUNNING, WAITING):
             self._run()
-        if self.state in (STOPPED, COMPLETED) and not self.interp.pulses and not self._ended_reported:
-            self._ended_reported = True
-            self._emit({"type": "end", "reason": self.end_reason or "completed"})
+        self._report_end()
 
     def next_wake_ns(self) -> int | None:
         """The earliest time the program or a pulse needs a tick, or None (only a signal change can
@@ -196,6 +198,19 @@ class Controller:
 
     def _fail(self, err: ExecError) -> None:
         self.state, self.error, self.wait = ERROR, err, None
-        self.interp.pulses.clear()
-        span = err.span
-        self._emit({"type": "error", "line": span.line if span else 0, "message": err.message})
+        self._report_end()
+
+    def _report_end(self) -> None:
+        """The last event, once the program has ended (completed, EXIT, Stop, an error) and the
+        pulses it started are over: the I/O system finishes a running PulseDO (and a pending SetDO
+        \\SDelay) after the program ends, as a real controller's does, so their edges come first,
+        at their own times, and the end or error event last, at the time of the last edge."""
+        if self._ended_reported or self.interp.pulses or self.state not in (STOPPED, COMPLETED, ERROR):
+            return
+        self._ended_reported = True
+        if self.state == ERROR:
+            span = self.error.span if self.error else None
+            self._emit({"type": "error", "line": span.line if span else 0,
+                        "message": self.error.message if self.error else ""})
+        else:
+            self._emit({"type": "end", "reason": self.end_reason or "completed"})

@@ -15,7 +15,7 @@ from typing import Callable
 from . import builtins as B
 from . import nodes as n
 from .host import MotionRequest
-from .runtime import ABSENT, Frame, Wait, to_ns
+from .runtime import ABSENT, PULSE, SDELAY, Frame, Wait, to_ns
 from .values import SIGNAL_TYPES, Record, fmt_num, format_value, json_num
 
 
@@ -72,7 +72,7 @@ class InstructionsMixin:
                 return B.rapid_trunc(x, arg("dec", 0.0))
             if key == "sqrt":
                 if x < 0:
-                    raise self.fail(f"Sqrt of a negative number ({fmt_num(x)})", e.span, "ERR_INVALID_VALUE")
+                    raise self.fail(f"Sqrt of a negative number ({fmt_num(x)})", e.span, "ERR_ARGVALERR")
                 return math.sqrt(x)
             if key == "pow":
                 return float(math.pow(vals[0], vals[1]))
@@ -91,19 +91,19 @@ class InstructionsMixin:
             if key in ("asin", "acos"):
                 if not -1 <= x <= 1:
                     raise self.fail(f"{e.name} of {fmt_num(x)}: the value must be -1 to 1", e.span,
-                                    "ERR_INVALID_VALUE")
+                                    "ERR_ARGVALERR")
                 return _clean(math.degrees(math.asin(x) if key == "asin" else math.acos(x)))
             if key == "orientzyx":
                 return B.orient_zyx(vals[0], vals[1], vals[2])
             if key == "eulerzyx":
                 axis = "x" if "x" in bound else "y" if "y" in bound else "z" if "z" in bound else None
                 if axis is None:
-                    raise self.fail("EulerZYX needs one of \\X, \\Y or \\Z", e.span, "ERR_INVALID_VALUE")
+                    raise self.fail("EulerZYX needs one of \\X, \\Y or \\Z", e.span, "ERR_ARGVALERR")
                 return B.euler_zyx(axis, arg("rotation"))
             if key == "numtostr":
-                return B.num_to_str(vals[0], vals[1], bool(vals[2]))
+                return self.string(B.num_to_str(vals[0], vals[1], bool(vals[2])), e.span)
             if key == "valtostr":
-                return format_value(x)
+                return self.string(format_value(x), e.span)
             if key == "strlen":
                 return float(len(x))
             if key == "strpart":
@@ -125,7 +125,7 @@ class InstructionsMixin:
                                     e.span, "ERR_OUTOFBND")
                 return float(sizes[d - 1])
         except (ValueError, OverflowError) as exc:
-            raise self.fail(f"{e.name}: {exc}", e.span, "ERR_INVALID_VALUE") from None
+            raise self.fail(f"{e.name}: {exc}", e.span, "ERR_ARGVALERR") from None
         raise self.fail(f"function {e.name} is not implemented", e.span)  # pragma: no cover
 
     # ---- instructions ---------------------------------------------------------------------------
@@ -198,11 +198,15 @@ class InstructionsMixin:
         yield from ()
 
     def i_setdo(self, s, arg, text, bound):
+        """SetDO takes a dionum: as the RAPID manual's table says, 0 sets the output to 0 and any
+        other value sets it to 1 (the trace shows the value the output gets: 0 or 1)."""
         sig, value, delay = arg("signal"), arg("value"), arg("sdelay")
+        value = 0.0 if value == 0 else 1.0
+        if delay is not None and not 0 <= delay <= 2000:
+            raise self.fail(f"SetDO \\SDelay must be 0 to 2000 s, not {fmt_num(delay)}",
+                            bound["sdelay"].value.span, "ERR_ARGVALERR")
         if delay:  # \SDelay: the program goes on, the output changes `delay` seconds later
-            if value not in (0, 1):
-                raise self.fail(f"a digital output is 0 or 1, not {fmt_num(value)}", bound["value"].value.span)
-            self.pulses.append((self.now + to_ns(delay), sig.name, float(value)))
+            self.pulses.append((self.now + to_ns(delay), sig.name, value, SDELAY))
             self.changes += 1
         else:
             self.write(sig, value, bound["value"].value.span)
@@ -230,20 +234,35 @@ class InstructionsMixin:
         yield from ()
 
     def i_pulsedo(self, s, arg, text, bound):
+        """PulseDO: the output goes to the pulse level now and back `\\PLength` (0.2 s) later; the
+        program does not wait. Without \\High the pulse inverts the output (a 0 output pulses to 1, a
+        1 output to 0); with \\High the output is 1 for the pulse length and then 0, whatever it was.
+
+        A PulseDO on an output that is still pulsing (its pulse has not ended) restarts that pulse:
+        the output is at the pulse level again (written, so traced, even though it does not change),
+        the pulse length counts from the new instruction, and at its end the output goes back to the
+        value it had before the *first* pulse (so two quick PulseDOs on a 0 output give one longer
+        pulse and the output ends at 0, never stuck at 1). With \\High the restarted pulse ends at 0,
+        as any \\High pulse does. SetDO/Set/Reset during a pulse write the output at once and do
+        not cancel the pulse's end edge."""
         sig = arg("signal")
         length = arg("plength", 0.2)
         if not 0.001 <= length <= 2000:
             raise self.fail(f"PulseDO \\PLength must be 0.001 to 2000 s, not {fmt_num(length)}",
-                            bound["plength"].value.span, "ERR_INVALID_VALUE")
-        current = self.host.read_signal(sig.name)
+                            bound["plength"].value.span, "ERR_ARGVALERR")
         high = arg("high", False)
+        running = next((p for p in self.pulses if p[1] == sig.name and p[3] == PULSE), None)
         self.pulses = [p for p in self.pulses if p[1] != sig.name]
-        if high or current == 0:  # positive pulse
-            self.write(sig, 1.0)
-            self.pulses.append((self.now + to_ns(length), sig.name, 0.0))
-        else:  # already high without \High: the level is inverted for the pulse length
-            self.write(sig, 0.0)
-            self.pulses.append((self.now + to_ns(length), sig.name, 1.0))
+        if high:
+            level, back = 1.0, 0.0
+        elif running is not None:  # still pulsing: restart the pulse, keep where it goes back to
+            back = running[2]
+            level = 1.0 - back
+        else:  # invert the present value for the pulse length
+            back = 1.0 if self.host.read_signal(sig.name) else 0.0
+            level = 1.0 - back
+        self.write(sig, level)
+        self.pulses.append((self.now + to_ns(length), sig.name, back, PULSE))
         yield from ()
 
     def i_tpwrite(self, s, arg, text, bound):
@@ -275,7 +294,7 @@ class InstructionsMixin:
         t = arg("time")
         if t < 0:
             raise self.fail(f"WaitTime needs a time >= 0, not {fmt_num(t)}", bound["time"].value.span,
-                            "ERR_INVALID_VALUE")
+                            "ERR_ARGVALERR")
         until = self.now + to_ns(t)
         while self.now < until:
             yield Wait("time", until, f"WaitTime {fmt_num(t)}", s.span)
@@ -313,7 +332,7 @@ class InstructionsMixin:
         cond = bound["cond"].value
         poll = to_ns(arg("pollrate", 0.1))
         if poll <= 0:
-            raise self.fail("WaitUntil \\PollRate must be > 0", bound["pollrate"].value.span, "ERR_INVALID_VALUE")
+            raise self.fail("WaitUntil \\PollRate must be > 0", bound["pollrate"].value.span, "ERR_ARGVALERR")
         f = arg.frame
         yield from self._wait_cond(s, arg, bound, lambda: self.truth(cond, f), "WaitUntil", poll)
 
@@ -329,8 +348,15 @@ class InstructionsMixin:
         target_key = "tojointpos" if instr == "MoveAbsJ" else "topoint"
         target = arg(target_key)
         via = arg("cirpoint") if instr == "MoveC" else None
+        speed = arg("speed")
+        for k in ("id", "t", "z", "inpos", "tload"):  # accepted and ignored (builtins._MOVE_OPTS), but evaluated
+            arg(k)
+        v = arg("v")
+        if v is not None:  # \V: the TCP speed in mm/s, instead of the speeddata's v_tcp
+            speed = speed.copy()
+            speed.fields["v_tcp"] = v
         req = MotionRequest(
-            instr=instr, target=target, via=via, speed=arg("speed"), zone=arg("zone"), tool=arg("tool"),
+            instr=instr, target=target, via=via, speed=speed, zone=arg("zone"), tool=arg("tool"),
             wobj=arg("wobj", self.predefined["wobj0"].value), target_name=text(target_key),
             via_name=text("cirpoint"), speed_name=text("speed"), zone_name=text("zone"),
             tool_name=text("tool"), wobj_name=text("wobj", "wobj0"), line=s.span.line)

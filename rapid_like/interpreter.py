@@ -30,8 +30,10 @@ from .host import Host, SignalInfo
 from .instructions import InstructionsMixin
 from .runtime import (ABSENT, NS, Cell, ExitSignal, Fatal, Frame, GotoSignal, Propagate, Ref, RetrySignal,
                       ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
-from .values import (SIGNAL_KINDS, SIGNAL_TYPES, Aggregate, Array, Record, SignalRef, TypeMismatch, a_, array_type,
+from .values import (SIGNAL_KINDS, SIGNAL_TYPES, STRING_MAX, Aggregate, Array, Record, SignalRef, TypeMismatch, a_, array_type,
                      coerce, default_value, describe_type, fmt_num, json_num, new_array, pos, xyz)
+
+GO_MAX = 2.0 ** 32 - 1  # the largest value of a 32-bit group output
 
 __all__ = ["Interpreter", "Wait", "NS", "to_ns", "ExitSignal", "Fatal", "Propagate"]
 
@@ -60,7 +62,8 @@ class Interpreter(InstructionsMixin):
         # leaves it unchanged and ends at the same loop would do the same again at the next tick.
         self.changes = 0
         self.errno = 0.0
-        self.pulses: list[tuple[int, str, float]] = []  # scheduled writes: (due ns, signal, value)
+        # scheduled output writes: (due ns, signal, value, PULSE | SDELAY)
+        self.pulses: list[tuple[int, str, float, str]] = []
         self.next_user_errno = B.USER_ERRNO_BASE
 
     # ---- set-up ---------------------------------------------------------------------------------
@@ -85,7 +88,8 @@ class Interpreter(InstructionsMixin):
         for e in d.dims:
             size = self.num(e, f)
             if size != int(size) or size < 1:
-                raise self.fail(f"an array size must be a whole number >= 1, not {fmt_num(size)}", e.span)
+                raise self.fail(f"an array size must be a whole number >= 1, not {fmt_num(size)}", e.span,
+                                "ERR_ILLDIM")
             sizes.append(int(size))
         t = array_type(d.type, len(sizes))
         if d.init is None:
@@ -94,7 +98,7 @@ class Interpreter(InstructionsMixin):
         if value.sizes() != sizes:  # type: ignore[union-attr]
             raise self.fail(f"{d.name} is declared with {{{', '.join(map(str, sizes))}}} elements, the "
                             f"initial value has {{{', '.join(map(str, value.sizes()))}}}",  # type: ignore[union-attr]
-                            d.init.span)
+                            d.init.span, "ERR_ILLDIM")
         return Cell(t, value, d.storage, d.name)
 
     def run(self, entry: str) -> Generator[Wait, None, None]:
@@ -114,10 +118,20 @@ class Interpreter(InstructionsMixin):
             raise self.fail(f"type mismatch: {e}", span) from None
 
     def write(self, sig: SignalRef, value: float, span: Span | None = None) -> None:
-        if sig.kind == "GO" and value != int(value):
-            raise self.fail(f"a group output takes whole numbers, not {fmt_num(value)}", span)
-        if sig.kind in ("DO",) and value not in (0, 1):
-            raise self.fail(f"a digital output is 0 or 1, not {fmt_num(value)}", span)
+        """Write an output (SetDO, Set, Reset, SetAO, SetGO, PulseDO) and trace it.
+
+        A group output takes a whole number from 0 to its range, else ERR_GO_LIM; offline a group's
+        width is not configured, so its range is that of RAPID's widest group, 32 bits (0 to
+        4294967295). An analog output has no limits offline (a station's signals have their own,
+        reported by the host as ERR_AO_LIM); only a value that is not a finite number is
+        ERR_AO_LIM."""
+        if sig.kind == "GO" and (not math.isfinite(value) or value != int(value) or not 0 <= value <= GO_MAX):
+            raise self.fail(f"SetGO {sig.name}: a group output takes a whole number from 0 to {GO_MAX:.0f}, "
+                            f"not {fmt_num(value)}", span, "ERR_GO_LIM")
+        if sig.kind == "AO" and not math.isfinite(value):
+            raise self.fail(f"SetAO {sig.name}: {fmt_num(value)} is not a finite value", span, "ERR_AO_LIM")
+        if sig.kind in ("DO",) and value not in (0, 1):  # pragma: no cover - SetDO maps its value to 0 or 1
+            raise self.fail(f"a digital output is 0 or 1, not {fmt_num(value)}", span, "ERR_ARGVALERR")
         self.host.write_signal(sig.name, float(value))
         self.emit({"type": sig.kind, "signal": sig.name, "value": json_num(float(value))})
 
@@ -127,10 +141,18 @@ class Interpreter(InstructionsMixin):
         if not due:
             return
         self.pulses = [p for p in self.pulses if p[0] > self.now]
-        for _, name, value in sorted(due):
+        for _, name, value, _kind in sorted(due):
             info = self.signals[name.lower()]
             self.host.write_signal(info.name, value)
             self.emit({"type": info.kind, "signal": info.name, "value": json_num(value)})
+
+    def string(self, text: str, span: Span | None) -> str:
+        """A string value made at run time (by `+`, NumToStr, ValToStr, ...): RAPID strings hold at
+        most 80 characters, a longer one is the runtime error ERR_STRTOOLNG."""
+        if len(text) > STRING_MAX:
+            raise self.fail(f"the string would be {len(text)} characters long: a RAPID string holds at most "
+                            f"{STRING_MAX}", span, "ERR_STRTOOLNG")
+        return text
 
     def emit(self, event: dict) -> None:
         self.changes += 1
@@ -152,8 +174,8 @@ class Interpreter(InstructionsMixin):
             return rs.value
         except Propagate as p:
             raise p.error from None
-        if r.kind == "FUNC":
-            raise self.fail(f"FUNC {r.name} ended without RETURN", r.span, "ERR_FNCNORET")
+        if r.kind == "FUNC":  # reached its ENDFUNC: the error is there, where the RETURN is missing
+            raise self.fail(f"FUNC {r.name} reached ENDFUNC without RETURN", r.end_span or r.span, "ERR_FNCNORET")
         return None
 
     def match(self, r_name: str, params: list[n.Param], args: list[n.Arg], f: Frame, span: Span) -> dict[str, n.Arg]:
@@ -272,7 +294,8 @@ class Interpreter(InstructionsMixin):
                 old = ref.get()
                 if isinstance(old, Array) and old.sizes() != value.sizes():
                     raise self.fail(f"type mismatch: {s.target.text} has {{{', '.join(map(str, old.sizes()))}}} "
-                                    f"elements, the value {{{', '.join(map(str, value.sizes()))}}}", s.value.span)
+                                    f"elements, the value {{{', '.join(map(str, value.sizes()))}}}", s.value.span,
+                                    "ERR_ILLDIM")
             ref.set(value)
             self.changes += 1
         elif isinstance(s, n.If):
@@ -390,7 +413,7 @@ class Interpreter(InstructionsMixin):
             v = cell.get()
             if v is ABSENT:
                 raise self.fail(f"optional argument {e.name} is not present (test it with Present({e.name}))",
-                                e.span, "ERR_ARGNOTPER")
+                                e.span, "ERR_NOTPRES")
             if isinstance(v, SignalRef):
                 return float(self.host.read_signal(v.name))
             if isinstance(v, (Record, Array)):
@@ -449,7 +472,7 @@ class Interpreter(InstructionsMixin):
         if op == "<>":
             return not self.equal(a, b, e.op_span)
         if op == "+" and isinstance(a, str) and isinstance(b, str):
-            return a + b
+            return self.string(a + b, e.op_span)
         if isinstance(a, Record) or isinstance(b, Record):
             return self.record_arith(op, a, b, e)
         for side, v in ((e.left, a), (e.right, b)):
@@ -530,7 +553,7 @@ class Interpreter(InstructionsMixin):
         out = []
         for i in e.indices:
             if not isinstance(arr, Array):
-                raise self.fail(f"{e.obj.text} has fewer dimensions than indices", i.span)
+                raise self.fail(f"{e.obj.text} has fewer dimensions than indices", i.span, "ERR_ILLDIM")
             k = self.num(i, f)
             if k != int(k) or not 1 <= k <= len(arr):
                 raise self.fail(f"index {fmt_num(k)} is outside {e.obj.text}{{1..{len(arr)}}}", i.span,

@@ -1,9 +1,10 @@
 """Lexer: RAPID source text to a list of tokens, each with its line and column.
 
 `!` starts a comment that runs to the end of the line. Strings are double-quoted; a quote inside a
-string is written twice (`""`) and a backslash as `\\\\`. Numbers are decimal, with an optional
-fraction and exponent (`9E9`, `1.5e-3`). An old-style `%%% VERSION:1 LANGUAGE:ENGLISH %%%` header
-at the top of a file is skipped.
+string is written twice (`""`) and a backslash as `\\\\`; a string literal holds at most 80
+characters, as every RAPID string does. Numbers are decimal, with an optional fraction and
+exponent (`9E9`, `1.5e-3`); `1.2.3` is a malformed number. An old-style
+`%%% VERSION:1 LANGUAGE:ENGLISH %%%` header at the top of a file is skipped.
 """
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import re
 
 from .errors import LexError, Span
 from .tokens import KEYWORDS, OPERATORS, Kind, Token
+from .values import STRING_MAX
 
 _HEADER = re.compile(r"\s*%%%.*?%%%", re.S)
 
@@ -67,6 +69,11 @@ def lex(source: str, file: str = "<input>") -> list[Token]:
                 else:
                     raise LexError(f"malformed number '{source[start:j]}': expected digits after the exponent",
                                    span_at(start))
+            if i + 1 < n and source[i] == "." and source[i + 1].isdigit():  # `1.2.3`
+                j = i
+                while j < n and (source[j].isdigit() or source[j] == "."):
+                    j += 1
+                raise LexError(f"malformed number '{source[start:j]}'", span_at(start))
             if i < n and (source[i].isalpha() or source[i] == "_"):
                 raise LexError(f"malformed number '{source[start:i + 1]}'", span_at(start))
             text = source[start:i]
@@ -93,6 +100,9 @@ def lex(source: str, file: str = "<input>") -> list[Token]:
                     continue
                 chars.append(c)
                 i += 1
+            if len(chars) > STRING_MAX:
+                raise LexError(f"a string of {len(chars)} characters: a RAPID string holds at most {STRING_MAX}",
+                               span_at(start))
             tokens.append(Token(Kind.STRING, source[start:i], span_at(start), start, i, "".join(chars)))
             continue
         for op in OPERATORS:

@@ -247,6 +247,7 @@ class Routine:
     error_handler: list[Stmt] | None = None
     return_type: str | None = None
     local: bool = False
+    end_span: Span | None = None  # its ENDPROC / ENDFUNC
 
     @property
     def key(self) -> str:

@@ -10,6 +10,16 @@ no clock read) and ended it at the same loop would do exactly the same at every 
 input changes, so the runner skips straight to the next `--set`, pulse edge or time limit.
 
 `--set` changes at time T are applied before the program runs at T.
+
+Pulses outlive the program. On a real controller the I/O system times a PulseDO, so a pulse that
+is still running when the program ends (completes, EXITs, executes Stop, or fails with a runtime
+error) still ends at its time and the output goes back to where it was; a pending SetDO \\SDelay
+is applied too. The run therefore goes on until those edges are written, and the trace's last line,
+`end` or `error`, comes after them at the time of the last edge: `t` never goes backwards and the
+end line is always last. So `PulseDO \\PLength:=1, do1; WaitTime 0.3; EXIT;` traces do1=1 at 0,
+do1=0 at 1.0 and `{"t": 1.0, "type": "end", "reason": "exit"}`; the program's own last event (here
+none after 0.3) tells when the program itself ended. A time limit cuts everything, pending edges
+included. `Outcome.t` is the end line's time.
 """
 from __future__ import annotations
 

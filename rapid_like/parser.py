@@ -254,8 +254,8 @@ class Parser:
         if self.tok.is_kw("ERROR"):
             self.advance()
             handler = self.block((end,), end, opener)
-        self.expect_kw(end)
-        return n.Routine(kw.span, kind, name.text, params, body, handler, rtype, local)
+        closing = self.expect_kw(end)
+        return n.Routine(kw.span, kind, name.text, params, body, handler, rtype, local, closing.span)
 
     def params(self) -> list[n.Param]:
         params: list[n.Param] = []
@@ -357,7 +357,9 @@ class Parser:
                 return self.for_stmt()
             if w == "TEST":
                 return self.test_stmt()
-            if w in ("VAR", "PERS", "CONST"):
+            if w == "PERS":
+                raise self.error("PERS data cannot be declared in a routine: declare it in the module")
+            if w in ("VAR", "CONST"):
                 decl = self.data_decl()
                 return n.LocalDecl(decl.span, decl)
             if w in ("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE"):
@@ -367,6 +369,9 @@ class Parser:
                 label = self.expect_ident("a label after GOTO")
                 self.end_of_instruction()
                 return n.Goto(t.span, label.text, label.span)
+        if t.is_op("%"):  # `%"proc" + NumToStr(n, 0)%;` calls the procedure a string names
+            raise self.error("late binding (%...%) is not supported by rapid_like: call the procedure by its "
+                             "name, e.g. in a TEST on the value")
         prev = self.toks[self.pos - 1] if self.pos else None
         if t.is_op(";") and prev is not None and prev.kind is Kind.KEYWORD and prev.upper in _CLOSERS | _ROUTINE_ENDS:
             raise self.error(f"unexpected ';' after {prev.upper}: a closing word takes no ';'")

@@ -17,6 +17,11 @@ def to_ns(seconds: float) -> int:
     return int(round(seconds * NS))
 
 
+# Kinds of scheduled output writes (`Interpreter.pulses`: (due ns, signal, value, kind)).
+PULSE = "pulse"  # the end edge of a PulseDO
+SDELAY = "sdelay"  # a SetDO \SDelay
+
+
 @dataclass
 class Wait:
     """What a suspended program waits for.

@@ -109,7 +109,7 @@ class TwinHost:
             try:
                 self.twin.write(sig.drives, sig.scale * value + sig.offset)
             except TwinError as exc:
-                errname = {"AO": "ERR_AO_LIM", "GO": "ERR_GO_LIM"}.get(sig.type, "ERR_INVALID_VALUE")
+                errname = {"AO": "ERR_AO_LIM", "GO": "ERR_GO_LIM"}.get(sig.type, "ERR_ARGVALERR")
                 raise HostError(f"{name} = {value:g} drives {exc}", errname) from None
             self.outputs[name] = float(value)
         else:

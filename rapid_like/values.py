@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass
 
 NUM, BOOL, STRING = "num", "bool", "string"
+STRING_MAX = 80  # characters in a RAPID string (longer: a static error in a literal, else ERR_STRTOOLNG)
 NUMERIC = {"num", "dnum", "errnum", "intnum", "dionum"}
 ATOMIC = NUMERIC | {BOOL, STRING}
 SIGNAL_TYPES = {"signaldi": "DI", "signaldo": "DO", "signalai": "AI", "signalao": "AO",
@@ -36,6 +37,10 @@ RECORDS: dict[str, list[tuple[str, str]]] = {
                  ("zone_ori", _N), ("zone_leax", _N), ("zone_reax", _N)],
     "loaddata": [("mass", _N), ("cog", "pos"), ("aom", "orient"), ("ix", _N), ("iy", _N), ("iz", _N)],
     "tooldata": [("robhold", BOOL), ("tframe", "pose"), ("tload", "loaddata")],
+    "inposdata": [("position", _N), ("speed", _N), ("mintime", _N), ("maxtime", _N)],
+    # `type` is a stoppoint (inpos 1, stoptime 2, fllwtime 3) and `relation` an opnum: nums here
+    "stoppointdata": [("type", _N), ("progsynch", BOOL), ("inpos", "inposdata"), ("stoptime", _N),
+                      ("followtime", _N), ("signal", STRING), ("relation", _N), ("checkvalue", _N)],
     "wobjdata": [("robhold", BOOL), ("ufprog", BOOL), ("ufmec", STRING), ("uframe", "pose"),
                  ("oframe", "pose")],
 }

@@ -109,3 +109,35 @@ def test_io_accepts_comma_lists_and_repeats(tmp_path: Path):
 def test_io_and_set_take_space_separated_lists_before_or_after_the_program(prog: Path):
     code, out, err = run_cli(["run", "--io", "DO:doLamp", "DI:diX", str(prog), "--set", "diX=1", "diX=0@1"])
     assert (code, out, err) == (0, "hello\n", "")
+
+
+@pytest.mark.parametrize("io, message", [
+    ("DI:reg1", "the configured I/O signal reg1 (DI) has the name of the predefined data reg1"),
+    ("DO:v100", "the configured I/O signal v100 (DO) has the name of the predefined data v100"),
+    ("DO:tool0", "has the name of the predefined data tool0"),
+    ("DO:Fine", "has the name of the predefined data fine"),
+    ("DO:z10", "has the name of the predefined data z10"),
+    ("DO:SetDO", "has the name of the built-in instruction SetDO"),
+    ("AI:abs", "has the name of the built-in function Abs"),
+    ("DI:errno", "has the name of the predefined data ERRNO"),
+    ("DI:While", "is the reserved word WHILE"),
+])
+def test_an_io_name_that_clashes_with_a_predefined_name_fails_before_anything_runs(prog: Path, io, message):
+    code, out, err = run_cli(["run", str(prog), "--io", "DO:doLamp," + io, "--trace"])
+    assert (code, out) == (65, "")
+    assert err.startswith(f"{prog}: error: the configured I/O signal ") and message in err.splitlines()[0], err
+    code, _, err = run_cli(["check", str(prog), "--io", "DO:doLamp," + io])
+    assert code == 65 and message in err
+
+
+def test_an_io_name_that_clashes_with_a_routine_is_reported_at_the_routine(prog: Path):
+    code, out, err = run_cli(["run", str(prog), "--io", "DO:doLamp,DI:other", "--trace"])
+    assert (code, out) == (65, "")
+    assert err.startswith(f"{prog}:6:3: error: PROC Other has the name of the configured I/O signal other (DI)")
+
+
+def test_help_documents_pulses_that_outlive_the_program(capsys):
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "after the edges of any PulseDO still running when the program ended" in text

@@ -317,3 +317,23 @@ ENDMODULE""", host=host)
                             host=RefusingHost([SignalInfo("aoAxis1", "AO")]))
     ctl2.tick(0.0)
     assert ctl2.state == "error" and (ctl2.error.span.line, ctl2.error.span.col) == (3, 5)
+
+
+def test_a_runtime_error_lets_a_running_pulse_end_and_reports_the_error_last():
+    ctl, host, events = make("""MODULE M
+  PROC main()
+    PulseDO \\PLength:=0.5, doP;
+    reg1 := 1 / 0;
+  ENDPROC
+ENDMODULE""", signals=[("DO", "doP")])
+    ctl.tick(0.0)
+    assert ctl.state == "error" and ctl.error.errname == "ERR_DIVZERO"  # at once
+    assert not ctl.finished and ctl.next_wake_ns() == 500_000_000  # the pulse is still running
+    assert [e["type"] for e in events] == ["DO"]
+    ctl.tick(0.5)
+    assert host.values["doP"] == 0  # not stuck at 1
+    assert events[-2:] == [{"t": 0.5, "type": "DO", "signal": "doP", "value": 0},
+                           {"t": 0.5, "type": "error", "line": 4, "message": "division by zero (ERR_DIVZERO)"}]
+    assert ctl.finished
+    ctl.tick(0.6)
+    assert len(events) == 3  # reported once
