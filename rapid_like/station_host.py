@@ -9,8 +9,9 @@ Two small adapters, one per side of the controller:
   the station's robot through the twin's motion API and are done when the robot is in position.
 - `ControllerDevice` is the twin's `Device`: it ticks the controller at the start of every simulation
   step (before the gripper and the robot act, so a `SetAO` takes effect in the same step), and adds the
-  controller's signals to the twin's signal table, so the Modbus server publishes them. Memory signals
-  are writable from outside (like RobotStudio's I/O simulator); wired ones are read-only mirrors.
+  controller's signals to the twin's signal table, so the Modbus server publishes them. Its unwired inputs
+  (DI, AI, GI) are written from outside (by the PLC); its outputs are read-only, unless marked `settable`
+  (like RobotStudio's I/O simulator); wired signals are read-only mirrors.
   After them come the program's own: `rapid.start` / `rapid.stop` (rising edges restart the program from
   its entry routine or stop it), `rapid.running`, `rapid.error` and `rapid.line` (where it waits).
 
@@ -162,6 +163,25 @@ class TwinHost:
         self.printed.append(text)
 
 
+def settable_from_outside(sig) -> bool:
+    """Who may set a controller signal from outside (a PLC, a test, an engineer): its inputs that no twin output
+    feeds (DI, AI, GI: the PLC's outputs to the robot), and outputs marked `settable` (RobotStudio's I/O
+    simulator, e.g. the thesis's path signals). The robot's other outputs are read-only, like every output."""
+    if sig.drives or sig.source:
+        return False
+    return sig.type in ("DI", "AI", "GI") or sig.settable
+
+
+def _wiring(sig) -> str:
+    if sig.drives:
+        return f"drives {sig.drives}"
+    if sig.source:
+        return f"reads {sig.source}"
+    if sig.type in ("DO", "AO", "GO"):
+        return "set by the robot program" + (", and from outside (I/O simulator)" if sig.settable else "")
+    return "set from outside"
+
+
 class ControllerDevice:
     """Steps the controller with the twin and publishes the controller's signals in the signal table."""
 
@@ -169,10 +189,9 @@ class ControllerDevice:
         self.host, self.controller = host, controller
         specs = []
         for sig in host.spec.io:
-            wired = sig.drives or sig.source
-            what = (f"drives {sig.drives}" if sig.drives else f"reads {sig.source}" if sig.source else "controller memory")
-            specs.append(SignalSpec(sig.name, OUTPUT if wired else INPUT, SIGNAL_TYPE[sig.type], sig.unit,
-                                    description=f"robot controller {sig.type} {sig.name} ({what})", group="controller"))
+            specs.append(SignalSpec(sig.name, INPUT if settable_from_outside(sig) else OUTPUT, SIGNAL_TYPE[sig.type],
+                                    sig.unit, description=f"robot controller {sig.type} {sig.name} ({_wiring(sig)})",
+                                    group="controller"))
         specs += [
             SignalSpec(START, INPUT, BOOL, group="controller",
                        description="a rising edge (re)starts the RAPID program from its entry routine (VAR data anew, PERS kept)"),

@@ -102,24 +102,28 @@ MODULE RingRigPlc
 
   PROC Path_PickOutside()
     SetDO movePickOutside,0;
+    TPWrite "Pick from outside on the right pallet";
     MoveJ Target_AppPickOutside,vmax,fine,tcpGripper\WObj:=wobj0;
     PickRing Target_AppPickOutside,Target_PickOutside;
   ENDPROC
 
   PROC Path_PlaceOutside()
     SetDO movePlaceOutside,0;
+    TPWrite "Place on the left pallet";
     MoveJ Target_AppPlaceOutside,vmax,fine,tcpGripper\WObj:=wobj0;
     PlaceRing Target_AppPlaceOutside,Target_PlaceOutside;
   ENDPROC
 
   PROC Path_PickInside()
     SetDO movePickInside,0;
+    TPWrite "Pick from inside on the left pallet";
     MoveJ Target_AppPickInside,vmax,fine,tcpGripper\WObj:=wobj0;
     PickRing Target_AppPickInside,Target_PickInside\Inside;
   ENDPROC
 
   PROC Path_PlaceInside()
     SetDO movePlaceInside,0;
+    TPWrite "Place on the right pallet";
     MoveJ Target_AppPlaceInside,vmax,fine,tcpGripper\WObj:=wobj0;
     PlaceRing Target_AppPlaceInside,Target_PlaceInside\Inside;
   ENDPROC
@@ -139,9 +143,9 @@ MODULE RingRigPlc
         SetDO doGripInside,0;
         SetAO aoFingerReady,OPEN_OUTSIDE;
       ENDIF
-      AskGripper doPrepare;
+      AskGripper doPrepare,"finger preparation";
       MoveL Pick,v1000,fine,tcpGripper\WObj:=wobj0;
-      AskGripper doGripRequest;
+      AskGripper doGripRequest,"grip";
       IF diGripOk=1 THEN
         bHolding := TRUE;
         TPWrite "Gripped the ring, attempt "\Num:=nAttempt;
@@ -150,7 +154,7 @@ MODULE RingRigPlc
         SetGO goMisses,nMisses;
         TPWrite "Missed grip, attempt "\Num:=nAttempt;
         ! open again before leaving, so nothing is dragged along
-        AskGripper doPrepare;
+        AskGripper doPrepare,"finger preparation";
       ENDIF
       MoveL Approach,v1000,fine,tcpGripper\WObj:=wobj0;
     ENDWHILE
@@ -159,7 +163,7 @@ MODULE RingRigPlc
   ! Go down with the ring, let the PLC release it, come straight back up.
   PROC PlaceRing(robtarget Approach,robtarget Place\switch Inside)
     MoveL Place,v1000,fine,tcpGripper\WObj:=wobj0;
-    AskGripper doReleaseRequest;
+    AskGripper doReleaseRequest,"release";
     IF diGripFault=1 THEN
       TPWrite "The ring did not come free";
       Stop;
@@ -169,16 +173,19 @@ MODULE RingRigPlc
   ENDPROC
 
   ! One job of the gripper PLC: set the request, wait until the PLC says it is done, take
-  ! the request back and wait until the PLC has seen that.
-  PROC AskGripper(VAR signaldo Request)
+  ! the request back and wait until the PLC has seen that. A PLC that does not answer
+  ! stops the cycle (doCycleFault) and the program.
+  PROC AskGripper(VAR signaldo Request,string Job)
     SetDO Request,1;
     WaitDI diGripDone,1\MaxTime:=PLC_TIMEOUT;
     SetDO Request,0;
     WaitDI diGripDone,0\MaxTime:=PLC_TIMEOUT;
   ERROR
     IF ERRNO=ERR_WAIT_MAXTIME THEN
-      TPWrite "The gripper PLC does not answer";
+      TPWrite "The gripper PLC did not answer the "+Job+" request within "+NumToStr(PLC_TIMEOUT,0)+" s";
       SetDO Request,0;
+      SetDO doCycleFault,1;
+      SetDO fullAutoRun,0;
       Stop;
     ENDIF
     RAISE;

@@ -144,3 +144,34 @@ def test_the_program_can_be_stopped_and_started_again_from_its_entry_routine_by_
         twin.write("rapid.start", True)  # from Init again: it sees the request and picks the ring
         run_until(twin, lambda: twin.read("doGripped"), 10.0)
         assert twin.read("rapid.running") and not twin.read("movePickOutside")
+
+
+def test_the_robots_outputs_are_read_only_from_outside_and_its_inputs_writable():
+    from twin.core.errors import SignalError
+
+    with open_cell(STATIONS / "ring_rig_plc") as twin:
+        kinds = {s.name: s.direction for s in twin.signals}
+        assert kinds["doGripRequest"] == kinds["goCycle"] == kinds["aoFingerReady"] == "output"  # robot DO/GO/AO
+        assert kinds["diGripDone"] == kinds["diGripOk"] == "input"  # the PLC's answers
+        assert kinds["fullAutoRun"] == "input"  # settable = true: the I/O simulator's signal
+        with pytest.raises(SignalError, match="doGripRequest.*output"):
+            twin.write("doGripRequest", True)
+
+
+def test_settable_is_only_for_outputs_that_drive_nothing(tmp_path):
+    station = copy_rig(tmp_path)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace('name = "diGripped"\ntype = "DI"\n', 'name = "diGripped"\ntype = "DI"\nsettable = true\n'))
+    with pytest.raises(StationError, match=r"controller\.io\[5\]\.settable"):
+        open_cell(station)
+
+
+def test_a_gripper_plc_that_does_not_answer_stops_the_cycle_with_a_clear_message():
+    events = []
+    with open_cell(STATIONS / "ring_rig_plc", on_event=events.append) as twin:  # no PLC connected
+        twin.write("fullAutoRun", True)
+        run_until(twin, lambda: not twin.read("rapid.running"), 40.0)
+        printed = [e["text"] for e in events if e["type"] == "print"]
+        assert printed[-1] == "The gripper PLC did not answer the finger preparation request within 30 s"
+        assert twin.read("doCycleFault") and not twin.read("fullAutoRun") and not twin.read("doPrepare")
+        assert twin.read("L2") == pytest.approx(0.35)  # nobody moved the fingers

@@ -109,6 +109,7 @@ class IOSignal:
     scale: float = 1.0  # twin value = scale * controller value + offset (and back for `source`)
     offset: float = 0.0
     unit: str = ""  # the controller's unit of an analogue signal (e.g. mm), for the register map
+    settable: bool = False  # an output the outside may set too (RobotStudio's I/O simulator)
 
 
 @dataclass(frozen=True)
@@ -378,7 +379,11 @@ def load_station(path: str | Path) -> Station:
                 scale=r.number("scale", 1.0),
                 offset=r.number("offset", 0.0),
                 unit=r.get("unit", str, ""),
+                settable=r.get("settable", bool, False),
             )
+            if sig.settable and (sig.type not in ("DO", "AO", "GO") or sig.drives):
+                raise r.error("settable", f"only an output that drives nothing can be settable from outside; "
+                                          f"{sig.name} is {'wired' if sig.drives else 'an input, always settable'}")
             if sig.drives and sig.type not in ("DO", "AO", "GO"):
                 raise r.error("drives", f"only an output (DO, AO, GO) can drive a twin input; {sig.name} is {sig.type}")
             if sig.source and sig.type not in ("DI", "AI", "GI"):
