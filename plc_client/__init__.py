@@ -4,11 +4,12 @@ PLC and the thesis's grip sequence.
     from plc_client import TwinClient, ScanCycle, ClientIO, GripSequence
 """
 from .client import ClientIO, RegisterMap, Signal, TwinClient
-from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, PlcClientError,
-                     SignalValueError, UnknownSignalError, ValueOutOfRangeError)
+from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, OutputRefusedError,
+                     PlcClientError, SignalValueError, UnknownSignalError, ValueOutOfRangeError)
 from .grip_sequence import Fault, GripSequence, Handshake, Phase
 from .scan import Combined, InputImage, ScanCycle, TwinIO, plc_logic
 
 __all__ = ["TwinClient", "RegisterMap", "Signal", "ClientIO", "ScanCycle", "Combined", "InputImage", "TwinIO", "plc_logic", "GripSequence",
            "Handshake", "Phase", "Fault", "PlcClientError", "MapError", "UnknownSignalError", "SignalValueError",
-           "ValueOutOfRangeError", "NotWritableError", "ModbusExceptionError", "ConnectionFailedError"]
+           "ValueOutOfRangeError", "NotWritableError", "ModbusExceptionError", "ConnectionFailedError",
+           "OutputRefusedError"]

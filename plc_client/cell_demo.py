@@ -15,7 +15,11 @@ It prints each step as it happens, the robot's TPWrite lines (relayed from the s
 PLC's view, both stamped with simulated time, then a summary: cycles, grips, misses, cycle time in
 simulated and in wall seconds, and how far the ring ends from where it started. `--remove-ring K`
 takes the ring out of the cell (coil `ring.present`) when cycle K starts: the miss is detected and
-reported, never hidden.
+reported, never hidden: the summary says whether the injected miss was detected and the robot stopped.
+
+Exit status: 0 when every cycle was done and the ring is back within 5 mm of where it started; with
+--remove-ring, 0 when the injected miss was detected and the robot stopped the cycle; 1 otherwise;
+2 for bad arguments or a station the demo cannot run.
 
 Lockstep (the default): the PLC advances the twin one scan at a time, so the run is repeatable to the
 bit and runs as fast as the machine allows. `--realtime`: the twin runs against the wall clock (at
@@ -31,13 +35,23 @@ from pathlib import Path
 from typing import Callable
 
 from . import ring_rig
-from .client import ClientIO
-from .grip_sequence import Phase
+from .client import ClientIO, quiet_native_output
+from .errors import PlcClientError
+from .grip_sequence import INSIDE, Fault, Phase
 from .scan import Combined, ScanCycle, plc_logic
-from .testing import twin_server
+
+# plc_client.testing (twin_server) is imported where the demo starts the server, not here: importing it
+# early keeps pytest from rewriting it when a test suite loads it as a plugin (PytestAssertRewriteWarning).
 
 DEFAULT_STATION = Path(__file__).resolve().parent.parent / "stations" / "ring_rig_plc"
 CYCLE_LIMIT_S = 120.0  # simulated seconds one cycle may take before the demo gives up
+RING_OK_MM = 5.0  # a cycle puts the ring back within this of where it started
+
+
+class DemoError(PlcClientError):
+    """The demo cannot run (a station that is not such a cell, bad parameters): one line, exit status 2."""
+
+
 WATCH = ("goCycle", "goCyclesDone", "goMisses", "doCycleFault", "sim.time_ms", "ring.x", "ring.y", "ring.z",
          "ring.present", "L2.actual", "L3.actual", "L4.actual", "doGripInside", "aoFingerReady")
 
@@ -70,10 +84,24 @@ class Summary:
     cycle_wall: list[float] = field(default_factory=list)
     ring_error_mm: float | None = None  # None: the ring is not in the cell
     ring_end: tuple[float, float, float] | None = None
+    remove_ring_at: int | None = None  # --remove-ring: the cycle at whose start the ring is taken away
+    ring_removed: bool = False  # ... and it was (cycle `remove_ring_at` started)
+    misses_after_removal: int = 0  # misses the PLC detected once the ring was gone
 
     @property
     def ok(self) -> bool:
-        return self.cycles_done == self.cycles_wanted and self.ring_error_mm is not None and self.ring_error_mm < 5.0
+        return self.cycles_done == self.cycles_wanted and self.ring_error_mm is not None and self.ring_error_mm < RING_OK_MM
+
+    @property
+    def fault_detected(self) -> bool:
+        """--remove-ring: the injected miss was detected by the PLC and the robot stopped the cycle."""
+        return self.ring_removed and self.misses_after_removal > 0 and self.stopped
+
+    @property
+    def exit_status(self) -> int:
+        if self.remove_ring_at is not None:
+            return 0 if self.fault_detected else 1
+        return 0 if self.ok else 1
 
 
 class CellDemo:
@@ -84,39 +112,60 @@ class CellDemo:
                  out: Callable[[str], None] | None = None):
         if cycles < 1:
             raise ValueError("at least one cycle")
+        if not (speed > 0 and scan_cycle > 0):
+            raise ValueError("speed and scan cycle must be greater than 0")
+        if remove_ring_at is not None and not 1 <= remove_ring_at <= cycles:
+            raise ValueError(f"the ring can be taken away at the start of cycle 1 to {cycles}, not {remove_ring_at}")
         self.station, self.cycles, self.realtime, self.speed = Path(station), cycles, realtime, speed
         self.remove_ring_at, self.scan_cycle = remove_ring_at, scan_cycle
         self.out = out or (lambda line: print(line, flush=True))
         self.now = 0.0  # simulated s, as last read from the server
         self.scans = 0  # PLC scans of the last run
         self.requests = 0  # Modbus requests the PLC sent in the last run
+        self.grip = ring_rig.cell_sequence()  # the gripper PLC
 
     def say(self, who: str, text: str) -> None:
         self.out(f"[t={self.now:8.3f} s] {who}: {text}")
 
     def run(self) -> Summary:
-        from twin.core.station import load_station
+        """Run the cell; a `DemoError` (or another `PlcClientError`) when it cannot."""
+        with quiet_native_output():  # pybullet's banner on import: an error must stay one line
+            from twin.core.errors import TwinError
+            from twin.core.station import load_station
 
-        start_xyz = next(t.pose.xyz for t in load_station(self.station).targets if t.name == "ring")
+            from .testing import twin_server
+            try:
+                station = load_station(self.station)
+            except TwinError as exc:
+                station, error = None, str(exc)
+        if station is None:
+            raise DemoError(error)
+        ring = next((t for t in station.targets if t.name == "ring"), None)
+        if ring is None:
+            raise DemoError(f"{self.station}: the demo needs a target 'ring' (its cell is stations/ring_rig_plc)")
+        start_xyz = ring.pose.xyz
+        logic = Combined(self.grip, operator(self.cycles, self.remove_ring_at))
         mode = "lockstep: the PLC steps the twin" if not self.realtime else f"real time x{self.speed:g}"
         self.out(f"demo: {self.station.name}, {self.cycles} cycle(s), {mode}, PLC scan {self.scan_cycle * 1000:g} ms")
         with twin_server(self.station, lockstep=not self.realtime, speed=None if not self.realtime else self.speed) as server:
+            missing = [n for n in dict.fromkeys((*logic.inputs, *logic.outputs, *WATCH)) if n not in server.map]
+            if missing:
+                raise DemoError(f"{self.station}: not a cell the demo can run: it has no {', '.join(missing)} "
+                                "(the demo runs stations/ring_rig_plc)")
             self.out(f"demo: twin serve (pid {server.process.pid}) listens on {server.host}:{server.port}; "
                      "the gripper PLC connects over Modbus/TCP")
             with server.client() as client:
-                return self._run(server, client, start_xyz)
+                return self._run(server, client, start_xyz, logic)
 
-    def _run(self, server, client, start_xyz) -> Summary:
-        grip = ring_rig.cell_sequence()
-        logic = Combined(grip, operator(self.cycles, self.remove_ring_at))
+    def _run(self, server, client, start_xyz, logic) -> Summary:
         plc = ScanCycle(ClientIO(client, lockstep=not self.realtime), logic, cycle=self.scan_cycle,
                         inputs=tuple(dict.fromkeys((*logic.inputs, *WATCH))), speed=self.speed if self.realtime else 1.0)
         grip_state = plc.state[0]
         log = _LogTail(server.log)
-        s = Summary(self.cycles)
+        s = Summary(self.cycles, remove_ring_at=self.remove_ring_at)
         wall0 = time.perf_counter()
         cycle_started: tuple[float, float] | None = None
-        seen = {"cycle": 0, "done": 0, "phase": Phase.IDLE}
+        seen = {"cycle": 0, "done": 0, "phase": Phase.IDLE, "fault": Fault.NONE}
         limit = CYCLE_LIMIT_S * self.cycles
         while True:
             image = plc.scan()
@@ -127,6 +176,10 @@ class CellDemo:
             if phase != seen["phase"]:
                 self._narrate_grip(seen["phase"], grip_state, image, s)
                 seen["phase"] = phase
+            if grip_state.fault != seen["fault"]:
+                if grip_state.fault is Fault.BAD_REQUEST:
+                    self._narrate_refusal(grip_state)
+                seen["fault"] = grip_state.fault
             if image["goCyclesDone"] != seen["done"]:
                 seen["done"] = s.cycles_done = image["goCyclesDone"]
                 if cycle_started is not None:
@@ -139,6 +192,7 @@ class CellDemo:
                 seen["cycle"] = image["goCycle"]
                 cycle_started = (self.now, time.perf_counter())
                 if self.remove_ring_at == seen["cycle"]:
+                    s.ring_removed = True
                     self.say("operator", "takes the ring out of the cell (ring.present = 0)")
             if image["doCycleFault"]:
                 s.stopped = True
@@ -165,17 +219,21 @@ class CellDemo:
         if st.phase is Phase.PREPARING:
             self.say("plc", f"fingers to {st.goal:g} mm ({'inside' if image['doGripInside'] else 'outside'})")
         elif st.phase is Phase.GRIPPING:
-            self.say("plc", f"grip from {st.mode}: closing on the ring at {grip_speed()} mm/s until every finger "
-                            f"reaches {grip_threshold()} N")
+            how = "opening into the bore" if st.mode == INSIDE else "closing on the ring"
+            self.say("plc", f"grip from {st.mode}: {how} at {self.grip.speed:g} mm/s until every finger "
+                            f"reaches {self.grip.threshold:g} N")
         elif st.phase is Phase.HELD:
             s.grips += 1
             forces = " / ".join(f"{v:.0f}" for v in st.forces_at_grip.values())
             self.say("plc", f"grip confirmed from {st.mode}: fingers at {fingers} mm, forces {forces} N")
         elif st.phase is Phase.FAULT_MISSED:
             s.misses += 1
+            if s.ring_removed:
+                s.misses_after_removal += 1
             self.say("plc", f"MISSED GRIP from {st.mode}: end of travel at {fingers} mm without force; fault to the robot")
         elif st.phase is Phase.RELEASING:
-            self.say("plc", "release: opening until the ring is free")
+            how = "closing out of the bore" if st.mode == INSIDE else "opening"
+            self.say("plc", f"release: {how} until the ring is free")
         elif st.phase is Phase.FAULT_STUCK:
             self.say("plc", f"RELEASE STUCK: the ring still touches a finger at {fingers} mm")
         elif st.phase is Phase.IDLE and before is Phase.RELEASING:
@@ -183,32 +241,47 @@ class CellDemo:
         elif st.phase is Phase.IDLE and before is Phase.PREPARING:
             self.say("plc", f"fingers ready at {fingers} mm")
 
+    def _narrate_refusal(self, st) -> None:
+        where = "no position" if st.refused is None else f"{st.refused:g} mm"
+        travel = "" if self.grip.travel is None else f", outside the axes' travel {self.grip.travel[0]:g}..{self.grip.travel[1]:g} mm"
+        self.say("plc", f"REFUSED the finger preparation to {where}{travel}: nothing moves; fault to the robot")
+
     def _print_summary(self, s: Summary, start_xyz, plc: ScanCycle) -> None:
         def avg(v):
-            return sum(v) / len(v) if v else float("nan")
+            return sum(v) / len(v)
 
         ring = ("not in the cell" if s.ring_end is None else
                 f"{s.ring_error_mm:.1f} mm from its start "
                 f"(at {s.ring_end[0]:.1f}, {s.ring_end[1]:.1f}, {s.ring_end[2]:.1f} mm; start "
                 f"{start_xyz[0] * 1000:.1f}, {start_xyz[1] * 1000:.1f}, {start_xyz[2] * 1000:.1f})")
         self.out("summary:")
-        self.out(f"  cycles      {s.cycles_done} of {s.cycles_wanted} completed"
-                 + ("; the robot stopped the cycle after a missed grip" if s.stopped else ""))
-        self.out(f"  grips       {s.grips} confirmed by force, {s.misses} missed")
+        self.out(f"  cycles          {s.cycles_done} of {s.cycles_wanted} completed"
+                 + (("; the robot stopped the cycle" + (" after a missed grip" if s.misses else "")) if s.stopped else ""))
+        self.out(f"  grips           {s.grips} confirmed by force, {s.misses} missed")
         if s.cycle_sim:
-            self.out(f"  cycle time  {avg(s.cycle_sim):.2f} s simulated, {avg(s.cycle_wall):.2f} s wall (mean of "
+            self.out(f"  cycle time      {avg(s.cycle_sim):.2f} s simulated, {avg(s.cycle_wall):.2f} s wall (mean of "
                      f"{len(s.cycle_sim)})")
-        self.out(f"  total       {s.sim_time:.2f} s simulated in {s.wall_time:.2f} s wall "
-                 f"({s.sim_time / s.wall_time:.1f}x real time), {plc.scans} PLC scans")
-        self.out(f"  ring        {ring}")
+        else:
+            self.out("  cycle time      no cycle completed")
+        self.out(f"  total           {s.sim_time:.2f} s simulated in {s.wall_time:.2f} s wall "
+                 f"({s.sim_time / max(s.wall_time, 1e-9):.1f}x real time), {plc.scans} PLC scans")
+        self.out(f"  ring            {ring}")
+        if s.remove_ring_at is not None:
+            self.out(f"  injected fault  {injected_fault_text(s)}")
 
 
-def grip_speed() -> str:
-    return f"{ring_rig.sequence().speed:g}"
-
-
-def grip_threshold() -> str:
-    return f"{ring_rig.sequence().threshold:g}"
+def injected_fault_text(s: Summary) -> str:
+    """The summary's verdict on --remove-ring: was the injected miss detected, did the robot stop?"""
+    k = s.remove_ring_at
+    if not s.ring_removed:
+        return f"ring to be taken away at the start of cycle {k}: NOT injected, cycle {k} never started"
+    text = f"ring taken away at the start of cycle {k}: "
+    n = s.misses_after_removal
+    if n:
+        text += f"the missed grip was detected ({n} miss{'es' if n != 1 else ''}), "
+        return text + ("the robot stopped the cycle" if s.stopped else "but the robot did NOT stop the cycle")
+    return text + "the missed grip was NOT detected" + (
+        ", though the robot stopped the cycle" if s.stopped else ", and the robot did not stop the cycle")
 
 
 class _LogTail:
@@ -237,31 +310,45 @@ class _LogTail:
 
 
 def main(args) -> int:
+    if args.remove_ring is not None and args.remove_ring > args.cycles:
+        raise DemoError(f"--remove-ring {args.remove_ring} is after the last cycle (--cycles {args.cycles}): "
+                        "the ring would never be taken away")
     demo = CellDemo(args.station, args.cycles, realtime=args.realtime, speed=args.speed,
                     remove_ring_at=args.remove_ring, scan_cycle=args.scan)
-    summary = demo.run()
-    if args.remove_ring is not None:
-        return 0 if summary.misses > 0 and summary.stopped else 1  # the fault had to be detected
-    return 0 if summary.ok else 1
+    return demo.run().exit_status
+
+
+EXIT_STATUS_HELP = """exit status:
+  0  every cycle was done and the ring is back within 5 mm of where it started;
+     with --remove-ring: the injected miss was detected and the robot stopped the cycle
+  1  otherwise (a cycle not done, the ring not back; with --remove-ring: the miss not detected,
+     or the robot did not stop)
+  2  bad arguments, or a station the demo cannot run"""
 
 
 def add_command(sub) -> None:
+    import argparse
+
+    from .cli import positive_float, positive_int
+
     p = sub.add_parser("demo", help="the ring rig's full automatic cycle: twin server, RAPID robot, PLC over Modbus/TCP",
-                       description=__doc__.split("\n\n")[1])
-    p.add_argument("--station", default=str(DEFAULT_STATION), help="the cell (default stations/ring_rig_plc)")
-    p.add_argument("--cycles", type=int, default=1, help="full cycles to run (default 1)")
+                       description=__doc__.split("\n\n")[2], epilog=EXIT_STATUS_HELP,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--station", metavar="DIR", default=str(DEFAULT_STATION), help="the cell (default stations/ring_rig_plc)")
+    p.add_argument("--cycles", type=positive_int, metavar="N", default=1, help="full cycles to run (default 1)")
     p.add_argument("--realtime", action="store_true", help="run the twin against the wall clock (default: lockstep)")
-    p.add_argument("--speed", type=float, default=1.0, help="with --realtime: X times real time (default 1)")
-    p.add_argument("--remove-ring", type=int, metavar="CYCLE", default=None,
-                   help="take the ring out of the cell when this cycle starts: a missed grip, detected and reported")
-    p.add_argument("--scan", type=float, default=0.010, help="PLC scan cycle, s (default 0.010)")
+    p.add_argument("--speed", type=positive_float, metavar="X", default=1.0, help="with --realtime: X times real time (default 1)")
+    p.add_argument("--remove-ring", type=positive_int, metavar="CYCLE", default=None,
+                   help="take the ring out of the cell when this cycle starts (1..--cycles): a missed grip, "
+                        "detected and reported; exit status 0 only if it is")
+    p.add_argument("--scan", type=positive_float, metavar="S", default=0.010, help="PLC scan cycle, s (default 0.010)")
     p.set_defaults(func=main)
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import argparse
+    from .cli import Parser
 
-    parser = argparse.ArgumentParser(prog="cell_demo")
+    parser = Parser(prog="cell_demo")
     add_command(parser.add_subparsers(dest="command", required=True))
     a = parser.parse_args(["demo", *sys.argv[1:]])
     sys.exit(a.func(a))

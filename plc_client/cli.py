@@ -1,16 +1,22 @@
 """The `plc` command: manual pokes at a running twin server, signals by name in engineering units.
 
     plc [--host H] [--port P] [--unit-id U] (--map FILE.json | --station DIR) COMMAND
-        read NAME...                      one line per signal: name, value, unit
-        write NAME=VALUE...               checked first: one bad name or value and nothing is written
+        read NAME...                      one line per signal: name, value, unit (an enumeration such as
+                                          GrippedPart: its index, then its text: `GrippedPart  1  (ring)`)
+        write NAME=VALUE...               checked first: one bad name or value and nothing is written;
+                                          sim.advance goes last, after the other writes are answered
         watch NAME... [--interval S] [--count N]   a live view (one redrawn line on a terminal)
-        run MODULE:NAME [--cycle S] [--seconds S]  run PLC logic (e.g. plc_client.ring_rig:sequence)
+        run MODULE:NAME [--cycle S] [--seconds S | --scans N] [--speed X]   run PLC logic on a scan cycle
         map                               the signals it knows: table, address, type, unit, range, access
-    plc demo [--cycles N] [--realtime] [--remove-ring CYCLE]   the main job (see plc_client.cell_demo)
+    plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE]   the main job (plc_client.cell_demo)
+
+E.g. the cell's gripper PLC against `twin serve stations/ring_rig_plc --port 5020 --lockstep`:
+    plc --station stations/ring_rig_plc run plc_client.ring_rig:cell_sequence
 
 The global options may also follow the command (`plc read L2 --port 5021`). Data goes to stdout; a
 problem is one line on stderr, `plc: error: ...`, with exit status 2 for a user error (unknown name, bad
-value, bad map) and 1 when the server cannot be reached or refuses a request.
+value, bad map, a map that is not the one the server serves) and 1 when the server cannot be reached or
+refuses a request, or when `plc run`'s logic sets an output the server refuses.
 """
 from __future__ import annotations
 
@@ -19,10 +25,37 @@ import logging
 import sys
 
 from .client import RegisterMap, Signal, TwinClient, range_text
-from .errors import ConnectionFailedError, ModbusExceptionError, PlcClientError, SignalValueError
+from .errors import ConnectionFailedError, ModbusExceptionError, OutputRefusedError, PlcClientError, SignalValueError
 
 EXIT_USER, EXIT_CONNECTION = 2, 1
 TRUE, FALSE = ("1", "true", "on", "yes", "high"), ("0", "false", "off", "no", "low")
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with the command's error style: one line on stderr, exit status 2."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USER, f"{self.prog}: error: {message} (`{self.prog} --help` tells more)\n")
+
+
+def positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a number, not {text!r}") from None
+    if not (v > 0 and v != float("inf")):
+        raise argparse.ArgumentTypeError(f"must be greater than 0, not {text}")
+    return v
+
+
+def positive_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"needs a whole number, not {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, not {text}")
+    return v
 
 
 def _globals(parser: argparse.ArgumentParser, suppress: bool) -> None:
@@ -38,10 +71,10 @@ def _globals(parser: argparse.ArgumentParser, suppress: bool) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="plc", description="Read, write and watch a twin server's signals by name.")
+    parser = Parser(prog="plc", description="Read, write and watch a twin server's signals by name.")
     _globals(parser, suppress=False)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    p = sub.add_parser("read", help="read signals: one line each, name value unit")
+    p = sub.add_parser("read", help="read signals: one line each, name value unit (enumerations: index, then (text))")
     p.add_argument("names", nargs="+", metavar="NAME")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_read)
@@ -57,11 +90,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_watch)
     p = sub.add_parser("run", help="run PLC logic (module:name or file.py:name) on a scan cycle against the server")
     p.add_argument("target", metavar="MODULE:NAME", help="a logic with .inputs (e.g. a GripSequence), or a function "
-                   "without arguments that returns one, e.g. plc_client.ring_rig:sequence")
-    p.add_argument("--cycle", type=float, default=0.010, help="scan cycle, s (default 0.010)")
+                   "without arguments that returns one, e.g. plc_client.ring_rig:cell_sequence (the gripper PLC "
+                   "of stations/ring_rig_plc)")
+    p.add_argument("--cycle", type=positive_float, default=0.010, help="scan cycle, s (default 0.010)")
     bound = p.add_mutually_exclusive_group()
-    bound.add_argument("--seconds", type=float, default=None, help="stop after this much PLC time")
-    bound.add_argument("--scans", type=int, default=None, help="stop after this many scans")
+    bound.add_argument("--seconds", type=positive_float, default=None, help="stop after this much PLC time")
+    bound.add_argument("--scans", type=positive_int, default=None, help="stop after this many scans")
+    p.add_argument("--speed", type=positive_float, default=None, metavar="X",
+                   help="real time: the PLC's clock runs X times the wall clock, to match `twin serve --speed X` "
+                        "(default: the server's speed, sim.speed_pct, else 1); no effect in lockstep")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--lockstep", dest="lockstep", action="store_true", default=None,
                       help="the server was started with --lockstep: each scan advances it one cycle (default: when the map has sim.advance)")
@@ -95,9 +132,17 @@ def cmd_read(args) -> int:
     signals = rmap.check_names(args.names)
     with connect(args, rmap) as client:
         values = client.read(*args.names)
-    rows = [(s.name, fmt(values[s.name]), s.unit) for s in signals]
-    print_rows(rows)
+    print_rows([read_row(s, values[s.name]) for s in signals])
     return 0
+
+
+def read_row(s: Signal, value) -> tuple[str, str, str]:
+    """name, value, unit; an enumeration shows the index it has on the wire, its text in the unit column."""
+    if s.choices:
+        if isinstance(value, str) and value in s.choices:
+            return s.name, str(s.choices.index(value)), f"({value or 'none'})"
+        return s.name, fmt(value), "(not one of the choices)"
+    return s.name, fmt(value), s.unit
 
 
 def cmd_write(args) -> int:
@@ -175,21 +220,41 @@ def load_logic(target: str):
     return obj
 
 
+def check_logic_signals(target: str, logic, rmap: RegisterMap) -> None:
+    """Every signal the logic reads or writes must be in the map: else one error naming the logic and all
+    the missing names (e.g. the generic handshake names of `ring_rig:sequence` against a station whose
+    robot program uses its own, where `ring_rig:cell_sequence` is the one that fits)."""
+    inputs = [n for n in logic.inputs if n not in rmap]
+    outputs = [n for n in getattr(logic, "outputs", ()) if n not in rmap and n not in inputs]
+    if not inputs and not outputs:
+        return
+    which = "the register map" + (f" ({rmap.source})" if rmap.source else "")
+    parts = []
+    if inputs:
+        parts.append(f"reads {', '.join(inputs)}")
+    if outputs:
+        parts.append(f"writes {', '.join(outputs)}")
+    raise UsageError(f"the logic {target} {' and '.join(parts)}, which {which} does not have "
+                     "(is it the logic for this station?)")
+
+
 def cmd_run(args) -> int:
     from .client import ClientIO
     from .scan import ScanCycle
+    from twin.modbus.register_map import SPEED_PCT
 
     logic = load_logic(args.target)
     rmap = load_map(args)
-    rmap.check_names(logic.inputs)
-    for name in getattr(logic, "outputs", ()):
-        rmap[name]
-    if args.cycle <= 0:
-        raise UsageError("--cycle must be greater than 0")
+    check_logic_signals(args.target, logic, rmap)
     with connect(args, rmap) as client:
-        plc = ScanCycle(ClientIO(client, lockstep=args.lockstep), logic, cycle=args.cycle)
-        print(f"plc: {args.target} every {args.cycle * 1000:g} ms, "
-              f"{'lockstep' if not plc.realtime else 'real time'}, against {args.host}:{args.port}",
+        io = ClientIO(client, lockstep=args.lockstep)
+        speed = args.speed
+        if speed is None:  # real time: keep pace with the server, as fast as it runs
+            pct = client.get(SPEED_PCT) if SPEED_PCT in rmap and not io.lockstep else 0
+            speed = pct / 100.0 if pct else 1.0
+        plc = ScanCycle(io, logic, cycle=args.cycle, speed=speed)
+        how = "lockstep" if not plc.realtime else f"real time x{speed:g}"
+        print(f"plc: {args.target} every {args.cycle * 1000:g} ms, {how}, against {args.host}:{args.port}",
               file=sys.stderr, flush=True)
         end = None if args.seconds is None else args.seconds - 1e-9
         try:
@@ -203,6 +268,9 @@ def cmd_run(args) -> int:
                         print(f"t={plc.time:8.3f}  " + "  ".join(f"{k}={fmt(v)}" for k, v in changed), flush=True)
         except KeyboardInterrupt:
             pass
+        except OutputRefusedError as exc:  # the logic commanded what the process cannot do: stop, say what
+            print(f"plc: error: {exc}; the PLC stopped", file=sys.stderr)
+            return EXIT_CONNECTION
     if plc.realtime and plc.overruns:
         print(f"plc: {plc.overruns} of {plc.scans} scans overran the {args.cycle * 1000:g} ms cycle", file=sys.stderr)
     return 0

@@ -10,12 +10,18 @@
 The register map comes from `twin map STATION --format json` output (a file) or from a station (built
 with the server's own `twin.modbus.register_map`, so both sides agree). A batch read groups signals at
 contiguous addresses of one table into one request. Values are checked against the map before anything
-is sent: an unknown name or an out-of-range value raises before the wire (see `plc_client.errors`).
+is sent: an unknown name or an out-of-range value (an entry without a range: its type's, whole numbers
+for integer types of scale 1, finite float32) raises before the wire (see `plc_client.errors`). A write
+sends `sim.advance` last. On connect, a map with `sim.map_crc` is checked against the server's CRC: a
+map of another station raises `MapError` instead of reading wrong values.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
+import os
+import sys
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -27,12 +33,53 @@ from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotW
 from .scan import LocalSignals
 
 from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
-                                      INPUT_REGISTER, LOCKSTEP, TABLES, Entry)
+                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, TABLES, Entry, map_crc)
 
 Signal = Entry  # one entry of the register map, as the server builds it (twin.modbus.register_map)
 WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
 MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
 MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
+INT_LIMITS = {"uint16": (0, 0xFFFF), "int16": (-0x8000, 0x7FFF), "uint32": (0, 0xFFFFFFFF),
+              "int32": (-0x80000000, 0x7FFFFFFF)}  # counts
+FLOAT32_MAX = 3.4028234663852886e38
+
+
+@contextlib.contextmanager
+def quiet_native_output():
+    """Silence what native code prints on stdout and stderr (file descriptors 1 and 2) meanwhile: pybullet's
+    "pybullet build time" banner at import and its "argv[0]=" lines, so that a `plc` or `plc demo` error
+    stays one line. Python exceptions are not affected (they propagate after the descriptors are back);
+    whatever else is written to the descriptors meanwhile is lost, so keep the block short."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (AttributeError, ValueError, OSError):
+            pass
+    saved: list[tuple[int, int]] = []
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+    except OSError:
+        yield
+        return
+    try:
+        for fd in (1, 2):
+            try:
+                saved.append((fd, os.dup(fd)))
+                os.dup2(devnull, fd)
+            except OSError:
+                pass
+        yield
+    finally:
+        try:
+            import ctypes
+
+            ctypes.CDLL(None).fflush(None)  # what C code buffered meanwhile goes to /dev/null too
+        except (OSError, AttributeError, TypeError):
+            pass
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+        os.close(devnull)
 
 
 def range_text(s: Signal) -> str:
@@ -48,7 +95,7 @@ def range_text(s: Signal) -> str:
 class RegisterMap:
     """The signals by name, as published by the server."""
 
-    def __init__(self, signals: Iterable[Signal], meta: Mapping[str, Any] | None = None):
+    def __init__(self, signals: Iterable[Signal], meta: Mapping[str, Any] | None = None, source: str = ""):
         self.signals: dict[str, Signal] = {}
         for s in signals:
             if s.table not in TABLES:
@@ -56,6 +103,7 @@ class RegisterMap:
             # the client speaks engineering units: encode(value) takes them as they are (factor 1)
             self.signals[s.name] = replace(s, factor=1.0, signal=None)
         self.meta = dict(meta or {})
+        self.source = source  # where the map came from, for messages: a file, or "station NAME"
         self.mapped: dict[str, set[int]] = {t: set() for t in TABLES}  # the addresses a read may cover
         for s in self.signals.values():
             self.mapped[s.table].update(range(s.address, s.address + s.count))
@@ -84,21 +132,30 @@ class RegisterMap:
             data = data.get("signals", data.get("entries", data.get("registers")))
         if not isinstance(data, list):
             raise MapError(f"{where}: expected a list of signals (the output of `twin map STATION --format json`)")
-        return cls((_signal_from_dict(e, where, i) for i, e in enumerate(data)), meta)
+        return cls((_signal_from_dict(e, where, i) for i, e in enumerate(data)), meta,
+                   where if where != "register map" else "")
 
     @classmethod
     def from_station(cls, station: str | Path) -> "RegisterMap":
         """Build the map the server would serve for this station (with the server's own map builder)."""
-        from twin.core.errors import TwinError
-        from twin.core.world import quiet_native_stdout
-        from twin.modbus import register_map as rm
+        with quiet_native_output():  # importing pybullet prints a banner on stderr, connecting argv[0] on stdout
+            from twin.core.errors import TwinError
+            from twin.modbus import register_map as rm
 
-        try:
-            with quiet_native_stdout():
+            try:
                 built = rm.build_map(station)
-        except (TwinError, rm.MapError) as exc:
-            raise MapError(str(exc)) from None
-        return cls(built.entries, {"station": built.station})
+            except (TwinError, rm.MapError) as exc:
+                error = str(exc)
+            else:
+                error = None
+        if error is not None:
+            raise MapError(error)
+        return cls(built.entries, {"station": built.station}, f"station {built.station!r}")
+
+    @property
+    def crc(self) -> int:
+        """The CRC-32 of the map, as the server publishes it in `sim.map_crc` (`twin.modbus.register_map.map_crc`)."""
+        return map_crc(self.signals.values())
 
     def as_list(self) -> list[dict]:
         """The map as `twin map --format json` prints it."""
@@ -160,7 +217,28 @@ def _check(s: Signal, value: Any) -> Any:
         raise SignalValueError(s.name, f"needs a number, not {value!r}")
     if (s.min is not None and value < s.min) or (s.max is not None and value > s.max):
         raise ValueOutOfRangeError(s.name, value, s.min, s.max, s.unit)
+    if s.type == "float32":
+        if math.isinf(value) or abs(value) > FLOAT32_MAX:
+            raise ValueOutOfRangeError(s.name, value, -FLOAT32_MAX if s.min is None else s.min,
+                                       FLOAT32_MAX if s.max is None else s.max, s.unit)
+        return value
+    limits = INT_LIMITS.get(s.type)
+    if limits is not None:  # the type's own range, for entries without min or max
+        if math.isinf(value):
+            raise SignalValueError(s.name, f"needs a finite number, not {value!r}")
+        counts = value / s.scale
+        if s.scale == 1.0 and counts != int(counts):
+            raise SignalValueError(s.name, f"needs a whole number ({s.type}), not {value!r}")
+        lo_c, hi_c = limits
+        if not lo_c <= round(counts) <= hi_c:
+            lo = s.min if s.min is not None else _eng(lo_c * s.scale)
+            hi = s.max if s.max is not None else _eng(hi_c * s.scale)
+            raise ValueOutOfRangeError(s.name, value, lo, hi, s.unit)
     return value
+
+
+def _eng(v: float) -> float | int:
+    return int(v) if float(v).is_integer() else v
 
 
 # -- encode / decode: the server's own (twin.modbus.register_map.Entry), in engineering units ---------------
@@ -246,6 +324,33 @@ class TwinClient:
         if not ok:
             self._client = None
             raise ConnectionFailedError(self.host, self.port, "connection refused or timed out")
+        try:
+            self._check_map()
+        except BaseException:
+            self.close()
+            raise
+
+    def _check_map(self) -> None:
+        """A map with `sim.map_crc`: the server must publish the same CRC, else it serves another map (a
+        smart_gripper server read with the ring_rig map would give wrong values without a word)."""
+        if MAP_CRC not in self.map:
+            return  # a map from before sim.map_crc: nothing to compare
+        ours = self.map.crc
+        given = f" ({self.map.source})" if self.map.source else ""
+        try:
+            theirs = self.get(MAP_CRC)
+        except ModbusExceptionError as exc:
+            if exc.code != 2:
+                raise
+            raise MapError(f"the server at {self.host}:{self.port} serves another register map than the one "
+                           f"given{given}: it has no {MAP_CRC} at input register {self.map[MAP_CRC].address} "
+                           "(an older twin serve?); take the map from the server's station: --station DIR, "
+                           "or `twin map STATION --format json`") from None
+        if theirs != ours:
+            raise MapError(f"the server at {self.host}:{self.port} serves another register map (another station?) "
+                           f"than the one given{given}: its {MAP_CRC} is {theirs:#010x}, the given map's "
+                           f"{ours:#010x}; take the map from the station the server runs: --station DIR, "
+                           "or `twin map STATION --format json`")
 
     def close(self) -> None:
         if self._client is not None:
@@ -293,7 +398,9 @@ class TwinClient:
 
     # -- by name ------------------------------------------------------------------------------------
     def read(self, *names: str) -> dict[str, Any]:
-        """Values by name, in engineering units, in the order asked. Unknown names raise before any request."""
+        """Values by name, in engineering units, in the order asked. Unknown names raise before any request.
+        An enumeration (an entry with `choices`, e.g. `GrippedPart`) reads as its text ("ring", "" for
+        none); on the wire it is the index into `choices` (`plc read` prints both: `1  (ring)`)."""
         if len(names) == 1 and not isinstance(names[0], str):
             names = tuple(names[0])
         signals = self.map.check_names(names)
@@ -305,9 +412,13 @@ class TwinClient:
 
     def write(self, values: Mapping[str, Any] | None = None, /, **more: Any) -> None:
         """Write signals by name (`write(L2=320.0)` or `write({"L2.x": 1})`). Everything is checked first:
-        one bad name or value and nothing is written. Contiguous registers go in one request."""
+        one bad name or value and nothing is written. Contiguous registers go in one request. `sim.advance`
+        goes last, in a request of its own, once every other write of the call has been answered: in
+        lockstep, `write(L2=320.0, **{"sim.advance": 10})` runs the 10 steps with L2 already set."""
         items = dict(values or {}, **more)
         checked = [(self.map[n], self.map.check_value(n, v)) for n, v in items.items()]
+        last = [(s, v) for s, v in checked if s.name == ADVANCE]
+        checked = [(s, v) for s, v in checked if s.name != ADVANCE]
         by_table: dict[str, list[tuple[Signal, list]]] = {}
         for s, v in sorted(checked, key=lambda sv: (sv[0].table, sv[0].address)):
             by_table.setdefault(s.table, []).append((s, encode(s, v)))
@@ -322,6 +433,8 @@ class TwinClient:
                 run.append((s, words))
             if run:
                 self._write_run(table, run)
+        for s, v in last:
+            self._write_run(s.table, [(s, encode(s, v))])
 
     def _write_run(self, table: str, run: list[tuple[Signal, list]]) -> None:
         start = run[0][0].address

@@ -7,7 +7,8 @@
     │   ├── ValueOutOfRangeError   outside the signal's range (names signal, value and range)
     │   └── NotWritableError       the signal is an output of the twin
     ├── ModbusExceptionError       the server answered with a Modbus exception (code, address, unit)
-    └── ConnectionFailedError      no server at host:port, or the connection broke
+    ├── ConnectionFailedError      no server at host:port, or the connection broke
+    └── OutputRefusedError         a scan cycle's logic set an output the process refused (names it)
 """
 from __future__ import annotations
 
@@ -87,5 +88,22 @@ class ConnectionFailedError(PlcClientError):
         super().__init__(f"cannot reach a twin server at {host}:{port}: {message}")
 
 
+class OutputRefusedError(PlcClientError):
+    """The logic of a scan cycle set an output that the process refused (a value out of range, an output of
+    the twin, a Modbus exception): the scan cycle stops there, nothing of that output image was written by
+    the client's checks (a Modbus exception may have come after part of it was sent)."""
+
+    def __init__(self, outputs: dict, cause: PlcClientError, scan: int, time: float):
+        self.outputs, self.cause, self.scan, self.time = dict(outputs), cause, scan, time
+        name = getattr(cause, "signal", None)
+        names = (name,) if name in self.outputs else tuple(n for n in getattr(cause, "signals", ()) if n in self.outputs)
+        shown = {n: self.outputs[n] for n in names} or self.outputs
+        what = ", ".join(f"{n}={_g(v)}" for n, v in shown.items())
+        s = "" if len(shown) == 1 else "s"
+        super().__init__(f"the PLC logic's output{s} {what} refused at scan {scan} (t={time:.3f} s): {cause}")
+
+
 def _g(v) -> str:
-    return f"{v:g}" if isinstance(v, (int, float)) else str(v)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return str(v)
+    return str(v) if isinstance(v, int) else f"{v:.10g}"

@@ -10,6 +10,8 @@ margin further. It grips from outside (closing) and from inside (opening), with 
                                     --end of travel, no force--> FAULT_MISSED
                                                     RELEASING --limit reached, part still touching--> FAULT_STUCK
     (optional) IDLE/FAULT --prepare request--> PREPARING --in position--> IDLE
+               IDLE/FAULT --prepare request outside `travel` (or with nowhere to go)--> fault BAD_REQUEST,
+                            nothing moves, `done` answers the request
     A new request clears a fault (a release from a fault opens the fingers for the next attempt).
 
 With `done` the handshake is request/acknowledge, safe whatever the scan times on either side: the robot
@@ -55,6 +57,7 @@ class Fault(IntEnum):
     NONE = 0
     MISSED = 1  # end of travel reached without the force threshold: no part between the fingers
     STUCK = 2  # release limit reached with the part still touching
+    BAD_REQUEST = 3  # a prepare request to a position outside the axes' travel (or with none): refused
 
 
 @dataclass(frozen=True)
@@ -91,6 +94,7 @@ class GripState:
     held_at: dict[str, float] = field(default_factory=dict)  # setpoints when the grip was confirmed
     job: str | None = None  # the request input whose rising edge started the current (or last) job
     forces_at_grip: dict[str, float] = field(default_factory=dict)
+    refused: float | None = None  # the position of the last prepare request refused (Fault.BAD_REQUEST)
 
 
 @dataclass
@@ -117,6 +121,9 @@ class GripSequence:
                     as arrived after this long
     per_finger      stop each axis by its own finger's force (axes and forces paired in order); default: when
                     there are as many axes as forces. Otherwise all axes move until every force passes.
+    travel          optional (low, high): the axes' setpoint range; a prepare request outside it is refused
+                    (fault `Fault.BAD_REQUEST`, `done` answers it, nothing is written) instead of sending a
+                    setpoint the process would refuse
     handshake       the names of the handshake signals (`Handshake`)
     """
 
@@ -137,9 +144,18 @@ class GripSequence:
     tolerance: float = 0.5
     settle: float = 1.0
     per_finger: bool | None = None
+    travel: tuple[float, float] | None = None
     handshake: Handshake = field(default_factory=Handshake)
 
     def __post_init__(self):
+        if self.travel is not None:
+            try:
+                lo, hi = (float(v) for v in self.travel)
+            except (TypeError, ValueError):
+                raise ValueError(f"travel must be (low, high), not {self.travel!r}") from None
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ValueError(f"travel must be (low, high) with low < high, not {self.travel!r}")
+            self.travel = (lo, hi)
         self.axes, self.forces = tuple(self.axes), tuple(self.forces)
         if not self.axes or not self.forces:
             raise ValueError("a grip sequence needs at least one axis and one force signal")
@@ -215,10 +231,14 @@ class GripSequence:
         elif prepare_edge and state.phase in (Phase.IDLE, Phase.FAULT_MISSED, Phase.FAULT_STUCK):
             mode = INSIDE if (h.inside and inputs[h.inside]) else OUTSIDE
             goal = inputs[h.prepare_position] if h.prepare_position else self.ready_position.get(mode)
-            if goal is not None:
+            state.job = h.prepare_request
+            if goal is None or not self.within_travel(float(goal)):
+                # refuse it: a fault, answered through `done`; nothing moves (and no setpoint the process
+                # would refuse is ever sent)
+                state.fault, state.refused = Fault.BAD_REQUEST, None if goal is None else float(goal)
+            else:
                 state.phase, state.fault, state.goal, state.since = Phase.PREPARING, Fault.NONE, float(goal), now
                 state.setpoint, state.at_end_since = dict(actual), None
-                state.job = h.prepare_request
 
         if state.phase is Phase.GRIPPING:
             self._grip_scan(state, forces, actual, elapsed, now)
@@ -247,6 +267,12 @@ class GripSequence:
             busy = state.phase in (Phase.GRIPPING, Phase.RELEASING, Phase.PREPARING)
             out[h.done] = bool(state.job and not busy and inputs[state.job])
         return out
+
+    def within_travel(self, position: float) -> bool:
+        """The position is one the axes can be set to (always, without `travel`; never, for NaN)."""
+        if math.isnan(position):
+            return False
+        return self.travel is None or self.travel[0] <= position <= self.travel[1]
 
     @staticmethod
     def _edge(inputs: Mapping, state: GripState, name: str | None) -> bool:

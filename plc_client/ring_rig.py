@@ -27,6 +27,7 @@ def sequence(handshake: Handshake | None = None, **overrides) -> GripSequence:
                   end_of_travel={"outside": 290.0, "inside": 230.0},
                   ready_position={"outside": 330.0, "inside": 150.0},
                   release_limit={"outside": 441.0, "inside": 0.0},
+                  travel=(0.0, 441.0),  # the axes' setpoint range (L2..L4: 0..441 mm)
                   handshake=handshake or Handshake())
     params.update(overrides)
     return GripSequence(**params)

@@ -6,7 +6,9 @@
 `logic(inputs, state) -> outputs` is a plain function of the input image (a read-only mapping of signal
 names to values, with `.time` in s since the PLC started, `.cycle` and `.scan`) and of its own state (any
 object the logic owns: no globals). It returns the outputs it wants set; the scan writes the ones that
-changed since the last scan (a PLC's output update) in one go.
+changed since the last scan (a PLC's output update) in one go. An output the process refuses (a value
+out of range, ...) stops the scan cycle with an `OutputRefusedError` that names it: a PLC program that
+commands what the process cannot do is a bug to fix, not a condition to ride over.
 
 The I/O (`ProcessIO`) is either the network client (`ClientIO`, in `plc_client.client`) or, for fast tests,
 a twin in the same process (`TwinIO`). A lockstep I/O moves the process by exactly one cycle per scan
@@ -20,6 +22,8 @@ import time
 from collections.abc import Callable, Iterable, Mapping
 from types import SimpleNamespace
 from typing import Any, Protocol
+
+from .errors import ConnectionFailedError, OutputRefusedError, PlcClientError
 
 DEFAULT_CYCLE = 0.010  # s
 
@@ -147,7 +151,12 @@ class ScanCycle:
         outputs = self.logic(image, self.state) or {}
         changed = {k: v for k, v in outputs.items() if k not in self.written or self.written[k] != v}
         if changed:
-            self.io.write_image(changed)
+            try:
+                self.io.write_image(changed)
+            except ConnectionFailedError:
+                raise
+            except PlcClientError as exc:  # e.g. a setpoint out of range: name it, do not just die
+                raise OutputRefusedError(changed, exc, self.scans, self.time) from exc
             self.written.update(changed)
         self.scans += 1
         self._pace()

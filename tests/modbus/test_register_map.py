@@ -129,3 +129,41 @@ def test_a_name_declared_twice_is_refused():
         build_register_map([SignalSpec("x", INPUT, BOOL), SignalSpec("x", OUTPUT, BOOL)])
     with pytest.raises(MapError, match="sim.step"):
         build_register_map([SignalSpec("sim.step", OUTPUT, INT)])
+
+
+# -- sim.map_crc: the map's own CRC, so a client can tell it holds the map the server serves -----------------
+def test_the_map_crc_sits_in_the_reserved_block_of_the_input_registers(rmap):
+    from twin.modbus.register_map import MAP_CRC
+
+    e = rmap[MAP_CRC]
+    assert (e.table, e.address, e.count, e.type, e.access) == (INPUT_REGISTER, 10, 2, "uint32", "r")
+    assert e.end <= RESERVED and e.signal is None
+
+
+def test_the_map_crc_covers_name_table_address_count_type_and_scale_of_every_other_entry(rmap):
+    import dataclasses
+    import zlib
+
+    from twin.modbus.register_map import MAP_CRC, RegisterMap, map_crc
+
+    order = [COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER]
+    rows = sorted((e for e in rmap if e.name != MAP_CRC), key=lambda e: (order.index(e.table), e.address))
+    canonical = "\n".join(f"{e.name},{e.table},{e.address},{e.count},{e.type},{e.scale:.10g}" for e in rows)
+    assert rmap.crc == map_crc(rmap) == zlib.crc32(canonical.encode())
+    assert build_register_map(SIGNALS, "another name").crc == rmap.crc  # same layout: same CRC
+
+    def changed(which, **kw):
+        return RegisterMap(tuple(dataclasses.replace(e, **kw) if e.name == which else e for e in rmap)).crc
+
+    assert changed("L2", description="else", unit="m", min=1.0) == rmap.crc  # not part of the layout
+    for kw in ({"address": 30}, {"type": "int32"}, {"scale": 0.1}, {"count": 2}, {"name": "L9"},
+               {"table": INPUT_REGISTER}):
+        assert changed("L2", **kw) != rmap.crc, kw
+    assert changed(MAP_CRC, address=12) == rmap.crc  # itself excluded
+    assert build_register_map(SIGNALS + (SignalSpec("L6", INPUT, FLOAT, "m", 0, 0.1),)).crc != rmap.crc
+
+
+def test_the_json_map_carries_the_crc_entry_and_gives_the_same_crc_on_the_client_side(rmap):
+    from plc_client.client import RegisterMap as ClientMap
+
+    assert ClientMap.from_json(rmap.to_json()).crc == rmap.crc

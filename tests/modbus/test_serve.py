@@ -160,6 +160,17 @@ def _decode(entry: dict, words: list[int]):
     return struct.unpack({"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i", "float32": ">f"}[entry["type"]], raw)[0]
 
 
+def map_crc_of(entries: list[dict]) -> int:
+    """The CRC-32 of a JSON map, computed here from the documented canonical form (not with the server's
+    code): `name,table,address,count,type,scale` per entry but sim.map_crc, by table then address."""
+    import zlib
+
+    order = ["coil", "discrete_input", "holding_register", "input_register"]
+    rows = sorted((e for e in entries if e["name"] != "sim.map_crc"), key=lambda e: (order.index(e["table"]), e["address"]))
+    text = "\n".join(f"{e['name']},{e['table']},{e['address']},{e['count']},{e['type']},{float(e['scale']):.10g}" for e in rows)
+    return zlib.crc32(text.encode())
+
+
 def test_every_entry_of_the_exported_json_map_reads_back_at_its_address_with_its_type(ring_map, lockstep_server):
     """The server's values, read entry by entry where the JSON says, against the same station stepped in
     this process with the same writes (the twin is deterministic, so they agree to the count)."""
@@ -190,7 +201,8 @@ def test_every_entry_of_the_exported_json_map_reads_back_at_its_address_with_its
             twin.write(name, v)
         twin.step(steps)
         sim = {"sim.advance": 0, "sim.step": steps, "sim.time_ms": steps * 12, "sim.late_steps": 0,
-               "sim.dt_us": 12000, "sim.mode": 0, "sim.speed_pct": 0, "fault": 0, "sim.lockstep": 1, "sim.late": 0}
+               "sim.dt_us": 12000, "sim.mode": 0, "sim.speed_pct": 0, "fault": 0, "sim.lockstep": 1, "sim.late": 0,
+               "sim.map_crc": map_crc_of(ring_map)}
         for e in ring_map:
             if e["name"] in sim:
                 assert got[e["name"]] == sim[e["name"]], e["name"]

@@ -53,6 +53,10 @@ def test_the_full_cycle_moves_the_ring_across_and_back_with_every_grip_confirmed
     assert re.search(r"grip confirmed from outside: fingers at 3(19|20)\.\d", text)
     assert re.search(r"grip confirmed from inside: fingers at (199|200)\.\d", text)
     assert "summary:" in text and "2 confirmed by force, 0 missed" in text
+    # the inside grip opens into the bore, the outside one closes on the ring
+    assert "grip from inside: opening into the bore" in text and "grip from outside: closing on the ring" in text
+    assert "grip from inside: closing" not in text
+    assert s.exit_status == 0 and "injected fault" not in text
 
 
 def test_the_cycle_in_lockstep_is_the_same_on_every_run(one_cycle):
@@ -72,6 +76,11 @@ def test_a_missed_grip_raises_the_fault_and_the_robot_does_not_carry_on():
     # it never went on to place a ring it does not hold: no release was ever asked for
     assert "release" not in text
     assert s.ring_end is None and not s.ok
+    # the verdict on the injected fault is explicit, and it is a success: detected, and the robot stopped
+    assert lines[-1] == ("  injected fault  ring taken away at the start of cycle 1: the missed grip was detected "
+                         "(2 misses), the robot stopped the cycle")
+    assert "  cycle time      no cycle completed" in lines
+    assert s.fault_detected and s.exit_status == 0
 
 
 def test_the_demo_command_prints_its_steps_and_a_summary():

@@ -77,3 +77,94 @@ def test_a_map_that_is_not_the_twin_map_output_is_a_clear_error(tmp_path):
         RegisterMap.from_json(bad)
     with pytest.raises(MapError, match="cannot read"):
         RegisterMap.from_json(tmp_path / "missing.json")
+
+
+# -- values outside the type's own range (entries without min/max) -------------------------------------------
+TYPED = [
+    {"name": "sim.advance", "table": "holding_register", "address": 0, "type": "uint16", "min": 0, "max": 65535, "access": "rw"},
+    {"name": "jaw_left", "table": "holding_register", "address": 16, "type": "uint16", "scale": 0.01, "unit": "mm",
+     "min": 0, "max": 25, "access": "rw"},
+    {"name": "goMisses", "table": "holding_register", "address": 17, "count": 2, "type": "int32", "access": "rw"},
+    {"name": "count", "table": "holding_register", "address": 19, "count": 2, "type": "uint32", "access": "rw"},
+    {"name": "small", "table": "holding_register", "address": 21, "type": "int16", "access": "rw"},
+    {"name": "word", "table": "holding_register", "address": 22, "type": "uint16", "access": "rw"},
+    {"name": "fine", "table": "holding_register", "address": 23, "count": 2, "type": "int32", "scale": 0.01,
+     "unit": "mm", "access": "rw"},
+    {"name": "aoFingerReady", "table": "holding_register", "address": 25, "count": 2, "type": "float32",
+     "unit": "mm", "access": "rw"},
+]
+
+
+@pytest.fixture
+def typed():
+    return RegisterMap.from_json(TYPED)
+
+
+@pytest.mark.parametrize("name, value, message", [
+    ("goMisses", 2 ** 31, r"signal 'goMisses': 2147483648 is out of range: -2147483648 to 2147483647$"),
+    ("goMisses", -2 ** 31 - 1, r"out of range: -2147483648 to 2147483647"),
+    ("count", -1, r"signal 'count': -1 is out of range: 0 to 4294967295$"),
+    ("count", 2 ** 32, r"out of range: 0 to 4294967295"),
+    ("small", 40000, r"out of range: -32768 to 32767"),
+    ("word", 65536, r"out of range: 0 to 65535"),
+    ("fine", 3e7, r"signal 'fine': 30000000 mm is out of range: -21474836.48 to 21474836.47 mm"),
+    ("aoFingerReady", 1e39, r"signal 'aoFingerReady': 1e\+39 mm is out of range: -3.402823466e\+38 to 3.402823466e\+38 mm"),
+    ("aoFingerReady", -1e39, r"out of range"),
+    ("aoFingerReady", float("inf"), r"inf mm is out of range"),
+])
+def test_a_value_outside_the_types_range_is_refused_for_entries_without_min_or_max(typed, name, value, message):
+    with pytest.raises(ValueOutOfRangeError, match=message):
+        typed.check_value(name, value)
+
+
+def test_a_fraction_for_a_whole_number_entry_is_refused_not_rounded(typed):
+    with pytest.raises(SignalValueError, match=r"signal 'goMisses': needs a whole number \(int32\), not 3.5"):
+        typed.check_value("goMisses", 3.5)
+    with pytest.raises(SignalValueError, match="whole number"):
+        typed.check_value("sim.advance", 2.5)
+    with pytest.raises(SignalValueError, match="needs a number"):
+        typed.check_value("aoFingerReady", float("nan"))
+    # what fits goes through: the type's limits, whole floats, fractions where the scale resolves them
+    for name, value in [("goMisses", 3.0), ("goMisses", -2 ** 31), ("count", 2 ** 32 - 1), ("small", -32768),
+                        ("word", 65535), ("fine", 12.34), ("aoFingerReady", 3.4e38), ("aoFingerReady", -150.5)]:
+        s = typed[name]
+        assert decode(s, encode(s, typed.check_value(name, value))) == pytest.approx(value, rel=1e-6)
+
+
+# -- sim.advance goes last -----------------------------------------------------------------------------------
+class _Recorder:
+    """Stands in for pymodbus's client: records the requests, answers each one."""
+
+    def __init__(self):
+        self.calls = []
+
+    def _answer(self, method, address, values):
+        self.calls.append((method, address, list(values)))
+        return type("Ok", (), {"isError": lambda self: False})()
+
+    def write_registers(self, address, values, device_id=1):
+        return self._answer("write_registers", address, values)
+
+    def write_coils(self, address, values, device_id=1):
+        return self._answer("write_coils", address, values)
+
+
+def test_sim_advance_is_written_last_in_a_request_of_its_own(typed):
+    from plc_client.client import TwinClient
+
+    client = TwinClient(typed)
+    client._client = _Recorder()
+    client.write(jaw_left=5, **{"sim.advance": 20})
+    client.write({"sim.advance": 3, "word": 7, "small": -1, "jaw_left": 6})
+    assert client._client.calls == [
+        ("write_registers", 16, [500]), ("write_registers", 0, [20]),
+        ("write_registers", 16, [600]), ("write_registers", 21, [0xFFFF, 7]), ("write_registers", 0, [3])]
+
+
+# -- plc read: an enumeration prints its index, its text in the unit column -------------------------------------
+def test_plc_read_shows_an_enumerations_index_with_its_text(rmap):
+    from plc_client.cli import read_row
+
+    assert read_row(rmap["GrippedPart"], "ring") == ("GrippedPart", "1", "(ring)")
+    assert read_row(rmap["GrippedPart"], "") == ("GrippedPart", "0", "(none)")
+    assert read_row(rmap["L2"], 320.5) == ("L2", "320.5", "mm")

@@ -114,3 +114,42 @@ def test_a_prepare_request_moves_the_fingers_to_the_position_the_robot_asks_for(
     b.wait(Phase.IDLE)
     assert b.io.get("L2.actual") == pytest.approx(340.0, abs=0.5) and not b.out("grip_busy")
     b.twin.close()
+
+
+def test_a_prepare_request_outside_the_travel_is_refused_with_a_fault_and_answered():
+    from plc_client.grip_sequence import Handshake
+
+    seq = ring_sequence(handshake=Handshake(prepare_request="prepare", prepare_position="prepare_mm", done="done",
+                                            fault_code="code"))
+    assert seq.travel == (0.0, 441.0)
+    b = Bench(BENCH, seq=seq)
+    b.plc.run(scans=3)
+    writes_before = dict(b.plc.written)
+    b.io.set("prepare_mm", 500.0)  # the robot asks for a position the axes cannot take
+    b.io.set("prepare", True)
+    b.plc.run(scans=5)  # no ValueOutOfRangeError from the process: nothing was sent
+    assert b.plc.state.phase is Phase.IDLE and b.plc.state.fault is Fault.BAD_REQUEST == 3
+    assert b.out("grip_fault") and b.out("code") == 3 and b.out("done") and not b.out("grip_busy")
+    assert {k: v for k, v in b.plc.written.items() if k in ("L2", "L3", "L4")} == \
+        {k: v for k, v in writes_before.items() if k in ("L2", "L3", "L4")}
+    assert b.io.get("L2") == 330.0 and b.io.get("L2.actual") == pytest.approx(330.0, abs=0.5)
+    b.io.set("prepare", False)  # the robot takes the request back: done falls, the fault stays
+    b.plc.scan()
+    assert not b.out("done") and b.out("grip_fault")
+    b.io.set("prepare_mm", 340.0)  # a valid request clears it
+    b.io.set("prepare", True)
+    b.wait(Phase.IDLE)
+    b.plc.scan()
+    assert not b.out("grip_fault") and b.out("done") and b.io.get("L2.actual") == pytest.approx(340.0, abs=0.5)
+    b.twin.close()
+
+
+@pytest.mark.parametrize("travel", [(441.0, 0.0), (0.0, float("inf")), (1.0,), "far"])
+def test_a_travel_that_is_not_low_high_is_refused(travel):
+    with pytest.raises(ValueError, match="travel"):
+        ring_sequence(travel=travel)
+
+
+def test_without_travel_any_prepare_position_is_passed_on():
+    seq = ring_sequence(travel=None)
+    assert seq.within_travel(1e6) and not seq.within_travel(float("nan"))

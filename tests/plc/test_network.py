@@ -1,15 +1,17 @@
 """The client, the `plc` command and the grip sequence against a real `twin serve` on loopback."""
 import importlib.util
+import json
 import os
 import subprocess
 import sys
+import time
 
 import pytest
 
-from plc_client import ClientIO, Phase, ScanCycle, TwinClient
-from plc_client.errors import ConnectionFailedError, UnknownSignalError, ValueOutOfRangeError
+from plc_client import ClientIO, Phase, RegisterMap, ScanCycle, TwinClient
+from plc_client.errors import ConnectionFailedError, MapError, UnknownSignalError, ValueOutOfRangeError
 from plc_client.testing import free_port, twin_server
-from tests.plc.conftest import BENCH, RING_FORCES, ring_sequence
+from tests.plc.conftest import BENCH, RING_FORCES, STATIONS, ring_sequence
 
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.cli") is None,
                                 reason="twin serve is not there yet (twin/modbus/cli.py)")
@@ -73,7 +75,7 @@ def test_plc_read_prints_name_value_unit(server):
     assert r.returncode == 0, r.stderr
     rows = [line.split() for line in r.stdout.splitlines()]
     assert rows[0] == ["L4", "330", "mm"] and rows[1][0] == "L2.force" and rows[1][2] == "N"
-    assert rows[2] == ["doGripped", "0"] and rows[3] == ["GrippedPart", '""']
+    assert rows[2] == ["doGripped", "0"] and rows[3] == ["GrippedPart", "0", "(none)"]  # index, then its text
 
 
 def test_plc_write_sets_signals_in_engineering_units(server, client):
@@ -186,3 +188,110 @@ def test_a_missed_grip_across_the_network_raises_the_fault_at_end_of_travel():
     assert plc_.state.phase is Phase.FAULT_MISSED and plc_.io.local["grip_fault"] and not plc_.io.local["gripped"]
     assert not twin["doGripped"]
     assert [twin[f"{a}.actual"] for a in ("L2", "L3", "L4")] == pytest.approx([290.0] * 3, abs=0.5)
+
+
+# -- sim.advance last, so a lockstep write-and-step is the same on every run -------------------------------------
+def test_plc_write_sends_sim_advance_after_the_other_writes(server, client):
+    step = client.get("sim.step")
+    r = plc(server, "write", "L4=325", "sim.advance=1")
+    assert r.returncode == 0, r.stderr
+    for _ in range(2000):
+        if client.get("sim.advance") == 0:
+            break
+    assert client.get("sim.step") == step + 1
+    assert client.get("L4.actual") < 330.0  # the one step ran with L4 already at 325
+    client.write(L4=330.0, **{"sim.advance": 100})
+    client.advance(1)
+
+
+def write_map(tmp_path, entries):
+    path = tmp_path / "map.json"
+    path.write_text(json.dumps(entries))
+    return path
+
+
+@pytest.mark.parametrize("assignment, message", [
+    ("goMisses=3.5", "plc: error: signal 'goMisses': needs a whole number (int32), not 3.5"),
+    ("goMisses=3000000000", "plc: error: signal 'goMisses': 3000000000 is out of range: -2147483648 to 2147483647"),
+    ("aoFingerReady=1e39", "plc: error: signal 'aoFingerReady': 1e+39 mm is out of range: "
+                           "-3.402823466e+38 to 3.402823466e+38 mm"),
+    ("aoFingerReady=inf", "plc: error: signal 'aoFingerReady': inf mm is out of range: "
+                          "-3.402823466e+38 to 3.402823466e+38 mm"),
+])
+def test_plc_write_refuses_values_outside_the_type_before_anything_is_sent(tmp_path, assignment, message):
+    path = write_map(tmp_path, [
+        {"name": "goMisses", "table": "holding_register", "address": 16, "count": 2, "type": "int32", "access": "rw"},
+        {"name": "aoFingerReady", "table": "holding_register", "address": 18, "count": 2, "type": "float32",
+         "unit": "mm", "access": "rw"}])
+    # no server at that port: a request would be exit 1, "cannot reach"
+    r = subprocess.run([sys.executable, "-m", "plc_client", "--map", str(path), "--port", str(free_port()),
+                        "write", assignment], capture_output=True, text=True, timeout=20)
+    assert (r.returncode, r.stdout, r.stderr.strip()) == (2, "", message)
+
+
+# -- the register map must be the one the server serves ------------------------------------------------------------
+def test_a_client_with_another_stations_map_is_refused_at_connect(server):
+    other = RegisterMap.from_station(STATIONS / "smart_gripper")
+    with pytest.raises(MapError, match=rf"the server at 127.0.0.1:{server.port} serves another register map "
+                                       r"\(another station\?\) than the one given \(station 'smart_gripper'\): "
+                                       r"its sim.map_crc is 0x[0-9a-f]{8}, the given map's 0x[0-9a-f]{8}"):
+        TwinClient.connect("127.0.0.1", server.port, map=other)
+    # a map from before sim.map_crc cannot be checked: it is taken as it is
+    old = RegisterMap.from_json([e for e in server.map.as_list() if e["name"] != "sim.map_crc"])
+    with TwinClient.connect("127.0.0.1", server.port, map=old) as c:
+        assert c.get("L2") == 330.0
+
+
+def test_plc_with_another_stations_map_is_exit_2(server):
+    r = subprocess.run([sys.executable, "-m", "plc_client", "--station", str(STATIONS / "smart_gripper"),
+                        "--port", str(server.port), "read", "sim.step"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.startswith(f"plc: error: the server at 127.0.0.1:{server.port} serves another register map")
+    assert len(r.stderr.splitlines()) == 1  # and no pybullet banner
+
+
+def test_plc_with_a_station_that_does_not_exist_is_one_line(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "plc_client", "--station", str(tmp_path / "nowhere"), "read", "L2"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.splitlines() == [f"plc: error: {tmp_path / 'nowhere'}: no such station file"]
+
+
+# -- plc run -------------------------------------------------------------------------------------------------------
+def test_plc_run_of_a_logic_for_another_station_names_it_and_every_missing_signal(server):
+    r = plc(server, "run", "plc_client.ring_rig:cell_sequence", "--scans", "1")
+    assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
+    assert r.stderr.startswith("plc: error: the logic plc_client.ring_rig:cell_sequence reads doGripRequest, "
+                               "doReleaseRequest, doGripInside, doPrepare, aoFingerReady and writes diGripOk, "
+                               "diGripFault, diGripDone, which the register map (/tmp/twin-map-")
+    assert r.stderr.rstrip().endswith("does not have (is it the logic for this station?)")
+
+
+def test_plc_run_stops_with_one_line_naming_an_output_the_server_refuses(server, client, tmp_path):
+    (tmp_path / "wild.py").write_text(
+        "from plc_client import plc_logic\n\n\n"
+        "@plc_logic(inputs=['L4.actual'])\n"
+        "def wild(inputs, state):\n"
+        "    return {'Active': True, 'L4': 500.0 if inputs.scan >= 3 else 330.0}\n")
+    r = plc(server, "run", f"{tmp_path / 'wild.py'}:wild", "--scans", "10", "--quiet")
+    assert r.returncode == 1, r.stderr
+    errors = [line for line in r.stderr.splitlines() if "error" in line]
+    assert errors == ["plc: error: the PLC logic's output L4=500 refused at scan 3 (t=0.030 s): signal 'L4': "
+                      "500 mm is out of range: 0 to 441 mm; the PLC stopped"]
+    assert client.get("L4") == 330.0
+
+
+def test_plc_run_in_real_time_keeps_the_pace_given_by_speed(server, tmp_path):
+    (tmp_path / "idle.py").write_text("from plc_client import plc_logic\n\n\n"
+                                      "@plc_logic(inputs=['L4.actual'])\n"
+                                      "def idle(inputs, state):\n"
+                                      "    return {}\n")
+    start = time.monotonic()
+    r = plc(server, "run", f"{tmp_path / 'idle.py'}:idle", "--realtime", "--speed", "8", "--seconds", "8")
+    took = time.monotonic() - start
+    assert r.returncode == 0, r.stderr
+    assert "real time x8" in r.stderr
+    assert took < 6.0  # 8 s of PLC time at 8x: 1 s of wall clock (plus the start), not 8
+    r = plc(server, "run", f"{tmp_path / 'idle.py'}:idle", "--speed", "0", "--scans", "1")
+    assert r.returncode == 2 and r.stderr.splitlines() == [
+        "plc run: error: argument --speed: must be greater than 0, not 0 (`plc run --help` tells more)"]

@@ -81,3 +81,24 @@ def test_real_time_scans_keep_the_cycle_against_the_wall_clock():
     plc.run(scans=20)
     assert io.advanced == 0.0  # the process runs on its own clock
     assert plc.time == pytest.approx(0.200, abs=0.030)
+
+
+def test_an_output_the_process_refuses_stops_the_scan_cycle_with_an_error_naming_it():
+    from plc_client.errors import OutputRefusedError, ValueOutOfRangeError
+
+    class Refusing(RecordingIO):
+        def write_image(self, values):
+            if values.get("L2", 0) > 441:
+                raise ValueOutOfRangeError("L2", values["L2"], 0.0, 441.0, "mm")
+            super().write_image(values)
+
+    def ramp(inputs, state):
+        return {"lamp": True, "L2": 400.0 + 20 * inputs.scan}
+
+    io = Refusing({"run": True})
+    plc = ScanCycle(io, ramp, inputs=["run"])
+    with pytest.raises(OutputRefusedError) as caught:
+        plc.run(scans=10)
+    assert str(caught.value) == ("the PLC logic's output L2=460 refused at scan 3 (t=0.030 s): "
+                                 "signal 'L2': 460 mm is out of range: 0 to 441 mm")
+    assert caught.value.outputs == {"L2": 460.0} and plc.written["L2"] == 440.0  # not taken as written

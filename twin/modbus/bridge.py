@@ -24,8 +24,8 @@ import traceback
 from collections.abc import Callable, Sequence
 
 from .register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, FAULT, HOLDING_REGISTER,
-                           INPUT_REGISTER, LATE, LATE_STEPS, LOCKSTEP, MODE, SPEED_PCT, STEP, TIME_MS, Entry,
-                           RegisterMap)
+                           INPUT_REGISTER, LATE, LATE_STEPS, LOCKSTEP, MAP_CRC, MODE, SPEED_PCT, STEP, TIME_MS,
+                           Entry, RegisterMap, map_crc)
 from .server import ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE, Images
 
 
@@ -45,6 +45,7 @@ class TwinBridge:
         self._entries = {t: rmap.table(t) for t in self._sizes}
         self._advance = rmap[ADVANCE] if ADVANCE in rmap else None
         self.live_addresses = frozenset({self._advance.address} if self._advance is not None else ())
+        self.crc = map_crc(rmap)  # published in sim.map_crc: the client checks it holds this map
         self.images: Images = Images(b"", b"", b"", b"")
         self.publish()
 
@@ -125,6 +126,7 @@ class TwinBridge:
             STEP: twin.step_count, TIME_MS: round(twin.time * 1000), DT_US: round(twin.dt * 1e6),
             LATE_STEPS: 0 if runner is None else runner.late_steps, MODE: 0 if lockstep else 1,
             SPEED_PCT: 0 if runner is None or lockstep else round(runner.speed * 100), ADVANCE: 0,
+            MAP_CRC: self.crc,
         }
 
     def publish(self) -> None:

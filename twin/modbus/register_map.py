@@ -16,8 +16,9 @@ Layout (addresses are 0-based protocol addresses):
   (`doGripped`, per axis `.in_position` and `.moving`, per finger `.contact`).
 - holding registers (read/write words): `sim.advance` at 0, then the analogue inputs.
 - input registers (read-only words): `sim.step`, `sim.time_ms`, `sim.late_steps`, `sim.dt_us`,
-  `sim.mode`, `sim.speed_pct`, then the analogue outputs (actual positions, finger forces, robot axes)
-  and `GrippedPart` (an index into the target group, 0 for none).
+  `sim.mode`, `sim.speed_pct`, `sim.map_crc` (10-11: the CRC-32 of the map itself, see `map_crc`, so a
+  client can tell it holds the map the server serves), then the analogue outputs (actual positions,
+  finger forces, robot axes) and `GrippedPart` (an index into the target group, 0 for none).
 
 Values are scaled integers in the engineering units the PLC sees, `value = counts * scale`:
 
@@ -43,6 +44,7 @@ import io
 import json
 import math
 import struct
+import zlib
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 
@@ -70,13 +72,25 @@ UNITS = {
 }
 
 # The twin's own registers (fixed addresses inside the reserved block).
-ADVANCE, STEP, TIME_MS, LATE_STEPS, DT_US, MODE, SPEED_PCT = (
-    "sim.advance", "sim.step", "sim.time_ms", "sim.late_steps", "sim.dt_us", "sim.mode", "sim.speed_pct")
+ADVANCE, STEP, TIME_MS, LATE_STEPS, DT_US, MODE, SPEED_PCT, MAP_CRC = (
+    "sim.advance", "sim.step", "sim.time_ms", "sim.late_steps", "sim.dt_us", "sim.mode", "sim.speed_pct",
+    "sim.map_crc")
 FAULT, LOCKSTEP, LATE = "fault", "sim.lockstep", "sim.late"
 
 
 class MapError(ValueError):
     """The signal table cannot be turned into a register map (e.g. a duplicate name)."""
+
+
+def map_crc(entries: Iterable) -> int:
+    """The CRC-32 of a register map: what `sim.map_crc` publishes, and what a client computes from the map it
+    was given to check that both are the same. Over every entry but `sim.map_crc` itself, in a canonical
+    form: one line `name,table,address,count,type,scale` per entry (scale with 10 significant digits), in
+    table order, then address order, joined by newlines, UTF-8. `entries`: objects with those attributes."""
+    order = {t: i for i, t in enumerate(TABLES)}
+    rows = sorted((e for e in entries if e.name != MAP_CRC), key=lambda e: (order.get(e.table, len(order)), e.address, e.name))
+    text = "\n".join(f"{e.name},{e.table},{int(e.address)},{int(e.count)},{e.type},{float(e.scale):.10g}" for e in rows)
+    return zlib.crc32(text.encode("utf-8")) & 0xFFFFFFFF
 
 
 @dataclass(frozen=True)
@@ -213,6 +227,11 @@ class RegisterMap:
     def __post_init__(self):
         object.__setattr__(self, "by_name", {e.name: e for e in self.entries})
 
+    @property
+    def crc(self) -> int:
+        """The CRC-32 of the map (`map_crc`), as `sim.map_crc` publishes it."""
+        return map_crc(self.entries)
+
     def __iter__(self):
         return iter(self.entries)
 
@@ -322,6 +341,9 @@ def _sim_entries() -> list[Entry]:
         E(MODE, INPUT_REGISTER, 7, 1, "uint16", 1.0, "", 0, 1, "r", "0 = lockstep, 1 = real time"),
         E(SPEED_PCT, INPUT_REGISTER, 8, 1, "uint16", 1.0, "%", 0, 65535, "r",
           "real time: speed in percent of real time (100 = real time); 0 in lockstep"),
+        E(MAP_CRC, INPUT_REGISTER, 10, 2, "uint32", 1.0, "", *u32, "r",
+          "CRC-32 of this register map (name, table, address, count, type and scale of every other entry): "
+          "a client compares it with the CRC of the map it was given"),
     ]
 
 
