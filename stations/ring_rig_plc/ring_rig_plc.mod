@@ -138,12 +138,11 @@ MODULE RingRigPlc
       Incr nAttempt;
       IF Present(Inside) THEN
         SetDO doGripInside,1;
-        SetAO aoFingerReady,OPEN_INSIDE;
+        FingersReady OPEN_INSIDE;
       ELSE
         SetDO doGripInside,0;
-        SetAO aoFingerReady,OPEN_OUTSIDE;
+        FingersReady OPEN_OUTSIDE;
       ENDIF
-      AskGripper doPrepare,"finger preparation";
       MoveL Pick,v1000,fine,tcpGripper\WObj:=wobj0;
       AskGripper doGripRequest,"grip";
       IF diGripOk=1 THEN
@@ -154,7 +153,7 @@ MODULE RingRigPlc
         SetGO goMisses,nMisses;
         TPWrite "Missed grip, attempt "\Num:=nAttempt;
         ! open again before leaving, so nothing is dragged along
-        AskGripper doPrepare,"finger preparation";
+        FingersReady aoFingerReady;
       ENDIF
       MoveL Approach,v1000,fine,tcpGripper\WObj:=wobj0;
     ENDWHILE
@@ -170,6 +169,19 @@ MODULE RingRigPlc
     ENDIF
     bHolding := FALSE;
     MoveL Approach,v1000,fine,tcpGripper\WObj:=wobj0;
+  ENDPROC
+
+  ! The PLC puts the fingers at Position (mm) before the robot goes down; a refused
+  ! preparation stops the cycle, so the robot never goes down with the fingers elsewhere.
+  PROC FingersReady(num Position)
+    SetAO aoFingerReady,Position;
+    AskGripper doPrepare,"finger preparation";
+    IF diGripFault=1 THEN
+      TPWrite "The gripper PLC refused to put the fingers at "+NumToStr(Position,0)+" mm";
+      SetDO doCycleFault,1;
+      SetDO fullAutoRun,0;
+      Stop;
+    ENDIF
   ENDPROC
 
   ! One job of the gripper PLC: set the request, wait until the PLC says it is done, take
