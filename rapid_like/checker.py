@@ -579,19 +579,8 @@ def _walk_stmts(stmts: list[n.Stmt]):
 
 
 def _walk_labels(stmts: list[n.Stmt]):
-    for s in stmts:
-        if isinstance(s, n.Label):
-            yield s
-        elif isinstance(s, n.If):
-            for _, body in s.branches:
-                yield from _walk_labels(body)
-            yield from _walk_labels(s.orelse or [])
-        elif isinstance(s, (n.While, n.For)):
-            yield from _walk_labels(s.body)
-        elif isinstance(s, n.Test):
-            for _, body in s.cases:
-                yield from _walk_labels(body)
-            yield from _walk_labels(s.default or [])
+    """Every label of `stmts`, nested ones included."""
+    return (s for s in _walk_stmts(stmts) if isinstance(s, n.Label))
 
 
 def _proper(key: str) -> str:
