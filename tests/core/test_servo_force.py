@@ -59,7 +59,16 @@ def test_a_free_finger_reads_almost_nothing_even_while_moving(tmp_path):
 def test_opening_from_a_hard_squeeze_acts_at_once(tmp_path):
     with four_finger(tmp_path) as twin:
         squeeze(twin, 0.0)
-        twin.write("F1", 0.08)
+        for f in ("F1", "F2", "F3", "F4"):
+            twin.write(f, 0.08)
         twin.step(round(0.25 / twin.dt))
         assert twin.read("F1.actual") > 0.045  # already moving away: the command did not run on to 0
-        assert twin.read("F1.force") < 2.0
+        assert twin.read("F1.force") < 2.0 and not twin.read("doGripped")
+
+
+def test_a_held_part_is_not_squeezed_into_the_fingers(tmp_path):
+    with four_finger(tmp_path, effort=400.0) as twin:
+        squeeze(twin, 0.0, seconds=4.0)  # far past the puck's side, for seconds, with 400 N
+        assert twin.read("doGripped") and twin.read("F1.force") == pytest.approx(400.0)
+        for f in ("F1", "F2", "F3", "F4"):
+            assert twin.read(f"{f}.actual") == pytest.approx(0.040, abs=0.0003)  # at the puck's side, not in it

@@ -3,7 +3,10 @@
 Before physics (`command`): each input is a servo setpoint. The joint moves towards it at its velocity
 limit with at most its effort limit (URDF velocity and effort, or the station's overrides), so it never
 jumps and it stops by itself against a part: unlike RobotStudio, each finger stops on contact and its
-force is known. Mimic joints follow their master. While `Active` is low every joint holds its command.
+force is known. Mimic joints are tied to their master by a gear constraint (a linkage, not a motor of their
+own). While a part is held (fixed to the base link) a joint presses towards it no further than 0.5 mm
+(0.005 rad) beyond where it gripped: it keeps its grip during fast moves but cannot sink into the part.
+While `Active` is low every joint holds its command.
 
 The force of a joint is its servo's: a command position moves towards the setpoint at the velocity
 limit, the joint follows it, and the force is `effort * following error / FULL_FORCE_ERROR` (2 mm or
@@ -16,7 +19,8 @@ far a finger sinks into a part, and so the force part-way up, still depends on t
 
 After physics (`sense`): per finger, a contact flag (a real geometric contact: closest distance to a
 target object within `contact_distance`, 0.5 mm by default, never the early contacts pybullet reports
-within its collision margin) and the servo force. When every finger touches the same target, the target
+within its collision margin) and its force: the largest servo force of the driven joints that carry it
+(its own joint, and e.g. the carriage a fine axis sits on). When every finger touches the same target, the target
 is fixed to the gripper's base link; when any finger loses it, it is released to physics again. This
 needs no setting for outside or inside grips: the rule is the same.
 """
@@ -36,6 +40,11 @@ DEFAULT_VELOCITY = {"m": 0.1, "rad": 1.0}  # when the URDF gives no velocity lim
 DEFAULT_EFFORT = {"m": 100.0, "rad": 10.0}  # when the URDF gives no effort limit
 FULL_FORCE_ERROR = {"m": 0.002, "rad": 0.02}  # following error at which a servo applies its effort limit
 POSITION_GAIN = 0.3  # pybullet motor: the velocity it asks for is POSITION_GAIN * error / substep
+BLOCKED_ERROR = {"m": 0.0002, "rad": 0.002}  # lag beyond the motor's own that says a part holds the joint back
+BLOCKED_SPEEDUP = 20.0  # how much faster than its limit a held-back joint's motor may ask to move (it cannot)
+HOLD_PRESS = {"m": 0.0005, "rad": 0.005}  # a held part: how far beyond the grip position a joint may still press
+MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
+MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
 
 
 @dataclass
@@ -78,6 +87,9 @@ class Gripper:
         self.mimics = [(joint_index[m.joint], master_input[m.master], m.multiplier, m.offset) for m in mechanism.mimics]
         self.finger_links = {f.name: [link_index[n] for n in f.links] for f in mechanism.fingers}
         self.finger_joint = {f.name: joint_index[f.joint] for f in mechanism.fingers}
+        driven = set(self.joint.values()) | {m[0] for m in self.mimics}
+        # the driven joints that carry each finger, its own first: a finger presses with the servos behind it
+        self.finger_servos = {f: [j for j in self._chain(joint) if j in driven] for f, joint in self.finger_joint.items()}
         self.active_input = spec.always_active  # the `Active` input as last written
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
@@ -89,11 +101,13 @@ class Gripper:
         self._command_speed: dict[str, float] = {inp.name: 0.0 for inp in mechanism.inputs}
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
+        self._held_at: dict[str, tuple[float, float]] = {}  # while a part is held: input -> (position, pressing sign)
         self.state = GripState()
         for inp in mechanism.inputs:
             client.resetJointState(body, self.joint[inp.name], self.setpoint[inp.name])
         for joint, master, mult, off in self.mimics:
             client.resetJointState(body, joint, mult * self.setpoint[master] + off)
+            self._couple(joint, master, mult, off)
         for links in self.finger_links.values():
             for link in links:
                 client.changeDynamics(body, link, lateralFriction=spec.friction)
@@ -135,25 +149,44 @@ class Gripper:
             velocity, effort = self.limits[name]
             full = FULL_FORCE_ERROR[self.unit[name]]
             target = _towards(self.command_position[name], goal[name], velocity * dt)
-            actual = c.getJointState(self.body, joint)[0]
+            actual, joint_speed = c.getJointState(self.body, joint)[:2]
             # a blocked joint's command runs on only as far as full force: a new setpoint acts at once
             target = min(max(target, actual - full), actual + full)
             # and a joint already further on its way than its command (leaving a part) pulls the command along
             ahead = (actual - target) * (goal[name] - target)
             if ahead > 0:
                 target = actual if abs(goal[name] - target) > abs(actual - target) else goal[name]
-            self._command_speed[name] = abs(target - self.command_position[name]) / dt
+            speed = abs(target - self.command_position[name]) / dt
+            self._command_speed[name] = speed
             self.command_position[name] = target
-            self._drive(joint, goal[name], velocity, effort)
-        for joint, master, mult, off in self.mimics:
-            velocity, effort = self.limits[master]
-            self._drive(joint, mult * goal[master] + off, velocity * abs(mult), effort)
+            # a joint held back by a part (its lag beyond what its speed explains) may press with its whole effort:
+            # pybullet's motor only pushes as hard as the velocity it asks for allows, so let it ask for more
+            blocked = (abs(target - actual) > speed * self._lag_per_speed + BLOCKED_ERROR[self.unit[name]]
+                       and abs(joint_speed) < MOVING_SPEED[self.unit[name]])  # standing: not merely lagging
+            self._drive(joint, self._press_limit(name, target), velocity * (BLOCKED_SPEEDUP if blocked else 1.0), effort)
 
-    def _force(self, joint: int, actual: float) -> float:
-        """The servo force of a joint after the step: effort * following error / full-force error. The lag a
-        free joint has behind a moving command (the motor's, not a load's) does not count."""
-        command, speed, effort, full_error = self._servo_of(joint)
-        error = max(0.0, abs(command - actual) - speed * self._lag_per_speed)
+    def _couple(self, joint: int, master: str, mult: float, off: float) -> None:
+        """Tie a mimic joint to its master as a mechanism does (a gear constraint: joint = mult * master + off),
+        with no motor of its own: the master's servo moves the whole linkage, and a part pushing one coupled
+        finger pushes them all (a self-centring chuck centres its part)."""
+        c = self.client
+        c.setJointMotorControl2(self.body, joint, pybullet.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0)
+        gear = c.createConstraint(self.body, joint, self.body, self.joint[master], pybullet.JOINT_GEAR,
+                                  [0, 0, 1], [0, 0, 0], [0, 0, 0])
+        # the constraint holds q_joint + gearRatio * q_master = relativePositionTarget
+        c.changeConstraint(gear, gearRatio=-mult, relativePositionTarget=off, erp=MIMIC_ERP,
+                           maxForce=MIMIC_FORCE_FACTOR * self.limits[master][1] * max(1.0, abs(mult)))
+
+    def _force(self, joint: int) -> float:
+        """The servo force of a joint after the step: effort * following error / full-force error. The lag that a
+        joint moving at its speed has behind its command (the motor's, not a load's) does not count; a joint
+        held by a part stands, so all of its error does."""
+        for j, master, _, _ in self.mimics:
+            if j == joint:  # a linkage has one motor: its master's, whose force every coupled finger feels
+                return self._force(self.joint[master])
+        actual, joint_speed = self.client.getJointState(self.body, joint)[:2]
+        command, _, effort, full_error = self._servo_of(joint)
+        error = max(0.0, abs(command - actual) - abs(joint_speed) * self._lag_per_speed)
         return effort * min(1.0, error / full_error)
 
     def _servo_of(self, joint: int) -> tuple[float, float, float, float]:
@@ -168,11 +201,30 @@ class Gripper:
                         self.limits[master][1], FULL_FORCE_ERROR[self.unit[master]] * abs(mult))
         return 0.0, 0.0, 0.0, 1.0  # not driven
 
-    def _drive(self, joint: int, goal: float, velocity: float, effort: float) -> None:
-        """Command one joint towards `goal` at its velocity limit with at most its effort limit. (pybullet's motor
-        is an implicit velocity constraint: stable for any finger mass, and it holds a carried part with the
-        full effort, but the force it reports against a contact depends on the solver, not on the servo.)"""
-        self.client.setJointMotorControl2(self.body, joint, pybullet.POSITION_CONTROL, targetPosition=goal,
+    def _chain(self, joint: int) -> list[int]:
+        """`joint` and the joints between it and the body's base, nearest first."""
+        chain = []
+        while joint >= 0:
+            chain.append(joint)
+            joint = self.client.getJointInfo(self.body, joint)[16]  # the parent link's (= its joint's) index
+        return chain
+
+    def _press_limit(self, name: str, target: float) -> float:
+        """While a part is fixed to the base link, a joint goes no further towards it than HOLD_PRESS beyond where
+        it held it when it was fixed: it keeps pressing (a carried part stays between the fingers) but cannot
+        sink on into the fixed part. Its command, and so its force, builds as before. Moving the
+        other way (opening a grip) is not held back."""
+        if name not in self._held_at:
+            return target
+        held, sign = self._held_at[name]
+        reach = held + sign * HOLD_PRESS[self.unit[name]]
+        return min(target, reach) if sign > 0 else max(target, reach)
+
+    def _drive(self, joint: int, target: float, velocity: float, effort: float) -> None:
+        """Command one joint towards its command position with at most its effort limit. (pybullet's motor is an
+        implicit velocity constraint: stable for any finger mass, and it holds a carried part with the full
+        effort; the force it reaches against a contact grows with the velocity it asks for.)"""
+        self.client.setJointMotorControl2(self.body, joint, pybullet.POSITION_CONTROL, targetPosition=target,
                                           force=effort, maxVelocity=velocity, positionGain=POSITION_GAIN, velocityGain=1.0)
 
     def _touching(self, finger: str) -> tuple[str, ...]:
@@ -193,10 +245,11 @@ class Gripper:
         axes = {}
         for name, joint in self.joint.items():
             pos, vel, _, _ = c.getJointState(self.body, joint)
-            axes[name] = AxisState(pos, vel, self._force(joint, pos))
+            axes[name] = AxisState(pos, vel, self._force(joint))
         fingers = {}
-        for finger, joint in self.finger_joint.items():
-            fingers[finger] = FingerState(self._touching(finger), self._force(joint, c.getJointState(self.body, joint)[0]))
+        for finger, servos in self.finger_servos.items():
+            force = max((self._force(j) for j in servos), default=0.0)
+            fingers[finger] = FingerState(self._touching(finger), force)
         self.state.axes, self.state.fingers = axes, fingers
         common = set(self.targets)
         for f in fingers.values():
@@ -222,12 +275,21 @@ class Gripper:
                                               rel_pos, [0, 0, 0], rel_orn, [0, 0, 0, 1])
         c.changeConstraint(self._constraint, maxForce=1e6)
         self.state.gripped = name
+        # where each joint holds the part, and which way it was heading (towards the part)
+        goal = self._hold if self._hold is not None else self.setpoint
+        self._held_at = {}
+        for inp, joint in self.joint.items():
+            actual = c.getJointState(self.body, joint)[0]
+            heading = goal[inp] - actual
+            if abs(heading) > 1e-9:
+                self._held_at[inp] = (actual, 1.0 if heading > 0 else -1.0)
 
     def _release(self) -> None:
         if self._constraint is not None:
             self.client.removeConstraint(self._constraint)
         self._constraint = None
         self.state.gripped = ""
+        self._held_at = {}
 
 
 def _towards(value: float, goal: float, step: float) -> float:
