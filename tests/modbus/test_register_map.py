@@ -87,9 +87,10 @@ def test_values_encode_as_scaled_counts_and_32_bit_values_high_word_first(rmap):
     assert rmap["L2.force"].decode([0x0001, 0x86A0]) == pytest.approx(1000.0)
 
 
-def test_outputs_saturate_at_their_type_limits(rmap):
+def test_outputs_saturate_at_their_declared_range_and_type_limits(rmap):
     assert rmap["L2.actual"].encode(-0.00002) == [0]
-    assert rmap["L2.actual"].encode(1.0) == [65535]
+    assert rmap["L2.actual"].encode(1.0) == [44100]  # a finger pressed past its 441 mm limit reads 441 mm
+    assert rmap["L2.force"].encode(1e9) == [0xFFFF, 0xFFFF]  # no upper bound: the type's limit
 
 
 def test_a_written_count_on_the_range_edge_maps_inside_the_si_range(rmap):

@@ -33,7 +33,7 @@ N, N*m     N, N*m      0.01                finger forces
 The type is the smallest that holds the signal's range: uint16, int16, then uint32, int32 (a signal
 without a range gets a 32-bit type); a float signal in another unit is a float32 of its SI value.
 32-bit values take two registers, **big-endian, high word first** (and big-endian bytes in each word).
-Enumerations are uint16 indices into their `choices` (0 = none). Outputs saturate at their type's
+Enumerations are uint16 indices into their `choices` (0 = none). Outputs saturate at their declared range and their type's
 limits (a finger a hair past its joint limit reads as the limit); inputs outside their range are
 refused (exception 03), never clamped.
 """
@@ -142,7 +142,8 @@ class Entry:
 
     # -- engineering value <-> words ------------------------------------------------------------------
     def counts_of(self, value) -> int | float:
-        """SI value (as the twin reads it) -> counts (saturated at the type's limits)."""
+        """SI value (as the twin reads it) -> counts (an output saturated at its declared range, anything at its
+        type's limits)."""
         if self.type == "bool":
             return 1 if value else 0
         if self.choices:
@@ -157,6 +158,11 @@ class Entry:
         if math.isnan(v):
             return 0
         lo, hi = _LIMITS[self.type]
+        if self.access == "r":  # an output a hair past its declared range (a finger pressed past its limit) reads as the limit
+            if self.min is not None:
+                lo = max(lo, math.ceil(self.min / self.scale - 1e-9))
+            if self.max is not None:
+                hi = min(hi, math.floor(self.max / self.scale + 1e-9))
         return lo if v <= lo else hi if v >= hi else int(round(v))
 
     def encode(self, value) -> list[int]:
