@@ -35,10 +35,12 @@ from pathlib import Path
 from typing import Callable
 
 from . import ring_rig
-from .client import ClientIO, quiet_native_output
+from .client import ClientIO
 from .errors import PlcClientError
 from .grip_sequence import INSIDE, Fault, Phase
 from .scan import Combined, ScanCycle, plc_logic
+
+from twin.native_output import quiet_native_output
 
 # plc_client.testing (twin_server) is imported where the demo starts the server, not here: importing it
 # early keeps pytest from rewriting it when a test suite loads it as a plugin (PytestAssertRewriteWarning).
@@ -129,7 +131,7 @@ class CellDemo:
 
     def run(self) -> Summary:
         """Run the cell; a `DemoError` (or another `PlcClientError`) when it cannot."""
-        with quiet_native_output():  # pybullet's banner on import: an error must stay one line
+        with quiet_native_output(stderr=True):  # pybullet's banner on import: an error must stay one line
             from twin.core.errors import TwinError
             from twin.core.station import load_station
 
@@ -286,8 +288,6 @@ def injected_fault_text(s: Summary) -> str:
 
 class _LogTail:
     """New lines of the server's log that the robot program wrote (its TPWrite and errors)."""
-
-    MARK = "robot"
 
     def __init__(self, path: Path):
         self.path, self.offset, self.rest = path, 0, ""

@@ -17,11 +17,8 @@ map of another station raises `MapError` instead of reading wrong values.
 """
 from __future__ import annotations
 
-import contextlib
 import json
 import math
-import os
-import sys
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -32,54 +29,16 @@ from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotW
                      SignalValueError, UnknownSignalError, ValueOutOfRangeError)
 from .scan import LocalSignals
 
+from twin.native_output import quiet_native_output
+
 from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
-                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, TABLES, Entry, map_crc)
+                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, TABLES, TYPE_LIMITS, Entry, map_crc)
 
 Signal = Entry  # one entry of the register map, as the server builds it (twin.modbus.register_map)
 WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
 MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
 MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
-INT_LIMITS = {"uint16": (0, 0xFFFF), "int16": (-0x8000, 0x7FFF), "uint32": (0, 0xFFFFFFFF),
-              "int32": (-0x80000000, 0x7FFFFFFF)}  # counts
 FLOAT32_MAX = 3.4028234663852886e38
-
-
-@contextlib.contextmanager
-def quiet_native_output():
-    """Silence what native code prints on stdout and stderr (file descriptors 1 and 2) meanwhile: pybullet's
-    "pybullet build time" banner at import and its "argv[0]=" lines, so that a `plc` or `plc demo` error
-    stays one line. Python exceptions are not affected (they propagate after the descriptors are back);
-    whatever else is written to the descriptors meanwhile is lost, so keep the block short."""
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (AttributeError, ValueError, OSError):
-            pass
-    saved: list[tuple[int, int]] = []
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-    except OSError:
-        yield
-        return
-    try:
-        for fd in (1, 2):
-            try:
-                saved.append((fd, os.dup(fd)))
-                os.dup2(devnull, fd)
-            except OSError:
-                pass
-        yield
-    finally:
-        try:
-            import ctypes
-
-            ctypes.CDLL(None).fflush(None)  # what C code buffered meanwhile goes to /dev/null too
-        except (OSError, AttributeError, TypeError):
-            pass
-        for fd, copy in saved:
-            os.dup2(copy, fd)
-            os.close(copy)
-        os.close(devnull)
 
 
 def range_text(s: Signal) -> str:
@@ -138,7 +97,7 @@ class RegisterMap:
     @classmethod
     def from_station(cls, station: str | Path) -> "RegisterMap":
         """Build the map the server would serve for this station (with the server's own map builder)."""
-        with quiet_native_output():  # importing pybullet prints a banner on stderr, connecting argv[0] on stdout
+        with quiet_native_output(stderr=True):  # importing pybullet prints a banner on stderr, connecting argv[0] on stdout
             from twin.core.errors import TwinError
             from twin.modbus import register_map as rm
 
@@ -222,7 +181,7 @@ def _check(s: Signal, value: Any) -> Any:
             raise ValueOutOfRangeError(s.name, value, -FLOAT32_MAX if s.min is None else s.min,
                                        FLOAT32_MAX if s.max is None else s.max, s.unit)
         return value
-    limits = INT_LIMITS.get(s.type)
+    limits = TYPE_LIMITS.get(s.type) if s.type != "bool" else None
     if limits is not None:  # the type's own range, for entries without min or max
         if math.isinf(value):
             raise SignalValueError(s.name, f"needs a finite number, not {value!r}")

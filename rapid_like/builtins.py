@@ -194,6 +194,17 @@ _FUNCTIONS = {
 FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, (s, r) in _FUNCTIONS.items()}
 PROPER_NAMES = {k.lower(): k for k in (*_INSTRUCTIONS, *_FUNCTIONS)}  # for messages: `Abs`, not `abs`
 
+
+def param_table(params: list[Param]) -> dict[str, Param]:
+    """{param key: param} over a signature's parameters and their `\\a | \\b` alternatives."""
+    return {q.key: q for p in params for q in (p, *p.alternatives)}
+
+
+# The built-ins' parameters by key, built once (the signatures never change).
+INSTRUCTION_PARAMS: dict[str, dict[str, Param]] = {k: param_table(ps) for k, ps in INSTRUCTIONS.items()}
+FUNCTION_PARAMS: dict[str, dict[str, Param]] = {k: param_table(ps) for k, (ps, _) in FUNCTIONS.items()}
+
+
 # Functions the evaluator implements itself (they need the host, the frame or the program).
 SPECIAL_FUNCTIONS = {"crobt", "cjointt", "present", "doutput", "dinput", "aoutput", "goutput", "testdi"}
 

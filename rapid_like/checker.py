@@ -318,11 +318,7 @@ class Checker:
         bound, msg, bad = B.match_args(params, args)
         if msg:
             raise self.err(f"{name}: {msg}", bad.span if bad else span)
-        every = {}
-        for p in params:
-            every[p.key] = p
-            for a in p.alternatives:
-                every[a.key] = a
+        every = B.param_table(params)
         for key, a in bound.items():
             p = every[key]
             if a.value is None:

@@ -43,9 +43,9 @@ from .errors import CheckError, ExecError, RapidError
 from .host import Host
 from .interpreter import NS, ExitSignal, Fatal, Interpreter, Propagate, Wait, to_ns
 from .parser import parse
+from .runtime import DEFAULT_LOOP_BUDGET  # time-less loop iterations per tick
 
 RUNNING, WAITING, STOPPED, COMPLETED, ERROR = "running", "waiting", "stopped", "completed", "error"
-DEFAULT_LOOP_BUDGET = 10_000  # time-less loop iterations per tick
 
 
 def read_source(path: str | Path) -> str:

@@ -44,7 +44,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Protocol, Sequence, runtime_checkable
 
-from .builtins import pose_inv, pose_mul, pose_of, predefined_data, tool_frame, wobj_frame
+from .builtins import Pose, _clean, pose_inv, pose_mul, pose_of, predefined_data, tool_frame, wobj_frame
 from .values import Record, default_value, record
 
 SIGNAL_KINDS = ("DI", "DO", "AI", "AO", "GI", "GO")
@@ -123,8 +123,7 @@ class InMemoryHost:
         for s in self.config:
             self.values.setdefault(s.name, 0.0)
         # the flange in the world, and the (tool, wobj) for which CRobT returns `position` as written
-        self.flange = pose_mul(pose_mul(wobj_frame(self.wobj), pose_of(self.position)),
-                               pose_inv(tool_frame(self.tool)))
+        self.flange = _flange(self.wobj, self.position, self.tool)
         self.active = (self.tool.copy(), self.wobj.copy())
 
     def signals(self) -> Sequence[SignalInfo]:
@@ -146,8 +145,7 @@ class InMemoryHost:
             self.joints = request.target.copy()
         else:
             self.position = request.target.copy()
-            self.flange = pose_mul(pose_mul(wobj_frame(request.wobj), pose_of(request.target)),
-                                   pose_inv(tool_frame(request.tool)))
+            self.flange = _flange(request.wobj, request.target, request.tool)
             self.active = (request.tool.copy(), request.wobj.copy())
         self.tool, self.wobj = request.tool.copy(), request.wobj.copy()  # the active tool and wobj
         return len(self.moves)
@@ -174,6 +172,7 @@ class InMemoryHost:
         self.printed.append(text)
 
 
-def _clean(x: float) -> float:
-    r = round(x, 9)
-    return 0.0 if r == 0 else r
+def _flange(wobj: Record, target: Record, tool: Record) -> Pose:
+    """The flange in the world for `target` (a robtarget in `wobj`) reached with `tool`:
+    wobj frame * target * inverse(tool.tframe)."""
+    return pose_mul(pose_mul(wobj_frame(wobj), pose_of(target)), pose_inv(tool_frame(tool)))

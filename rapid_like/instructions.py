@@ -29,19 +29,20 @@ class InstructionsMixin:
             raise self.fail(f"unknown function '{e.name}'", e.span)
         params, rtype = B.FUNCTIONS[key]
         bound = self.match(e.name, params, e.args, f, e.span)
-        ptypes = {q.key: q.type for p in params for q in (p, *p.alternatives)}
+        ptable = B.FUNCTION_PARAMS[key]
 
         def arg(name: str, default: object = None) -> object:
             a = bound.get(name)
             if a is None:
                 return default
-            if ptypes[name] == "switch":
+            ptype = ptable[name].type
+            if ptype == "switch":
                 return True
-            if ptypes[name] in SIGNAL_TYPES:
-                return self.signal_arg(a.value, f, SIGNAL_TYPES[ptypes[name]])
-            if ptypes[name] == "any":
+            if ptype in SIGNAL_TYPES:
+                return self.signal_arg(a.value, f, SIGNAL_TYPES[ptype])
+            if ptype == "any":
                 return self.eval(a.value, f)  # type: ignore[arg-type]
-            return self.coerce(self.eval(a.value, f), ptypes[name], a.value.span)  # type: ignore[union-attr]
+            return self.coerce(self.eval(a.value, f), ptype, a.value.span)  # type: ignore[union-attr]
 
         names = [p.key for p in params]
         if key == "present":
@@ -135,13 +136,13 @@ class InstructionsMixin:
             raise self.fail(f"unknown instruction or procedure '{s.name}'", s.span)
         params = B.INSTRUCTIONS[key]
         bound = self.match(s.name, params, s.args, f, s.span)
-        ptypes = {q.key: q for p in params for q in (p, *p.alternatives)}
+        ptable = B.INSTRUCTION_PARAMS[key]
 
         def arg(name: str, default: object = None) -> object:
             a = bound.get(name)
             if a is None:
                 return default
-            p = ptypes[name]
+            p = ptable[name]
             if p.type == "switch":
                 return True
             if p.type in SIGNAL_TYPES:
@@ -380,9 +381,6 @@ class InstructionsMixin:
 
     def i_moveabsj(self, s, arg, text, bound):
         yield from self._move(s, arg, text, bound, "MoveAbsJ")
-
-
-
 
 
 def _clean(x: float) -> float:

@@ -28,8 +28,8 @@ from . import nodes as n
 from .errors import ExecError, Span
 from .host import Host, SignalInfo
 from .instructions import InstructionsMixin
-from .runtime import (ABSENT, NS, Cell, ExitSignal, Fatal, Frame, GotoSignal, Propagate, Ref, RetrySignal,
-                      ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
+from .runtime import (ABSENT, DEFAULT_LOOP_BUDGET, NS, Cell, ExitSignal, Fatal, Frame, GotoSignal, Propagate, Ref,
+                      RetrySignal, ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
 from .values import (SIGNAL_KINDS, SIGNAL_TYPES, STRING_MAX, Aggregate, Array, Record, SignalRef, TypeMismatch, a_, array_type,
                      coerce, default_value, describe_type, fmt_num, json_num, new_array, pos, xyz)
 
@@ -42,7 +42,7 @@ class Interpreter(InstructionsMixin):
     """Runs one module against a host; the Controller drives `run()` and sets `now` before each resume."""
 
     def __init__(self, module: n.Module, host: Host, emit: Callable[[dict], None] | None = None,
-                 loop_budget: int = 10_000):
+                 loop_budget: int = DEFAULT_LOOP_BUDGET):
         self.module = module
         self.host = host
         self._sink = emit or (lambda ev: None)
@@ -130,8 +130,6 @@ class Interpreter(InstructionsMixin):
                             f"not {fmt_num(value)}", span, "ERR_GO_LIM")
         if sig.kind == "AO" and not math.isfinite(value):
             raise self.fail(f"SetAO {sig.name}: {fmt_num(value)} is not a finite value", span, "ERR_AO_LIM")
-        if sig.kind in ("DO",) and value not in (0, 1):  # pragma: no cover - SetDO maps its value to 0 or 1
-            raise self.fail(f"a digital output is 0 or 1, not {fmt_num(value)}", span, "ERR_ARGVALERR")
         self.host.write_signal(sig.name, float(value))
         self.emit({"type": sig.kind, "signal": sig.name, "value": json_num(float(value))})
 
@@ -184,11 +182,12 @@ class Interpreter(InstructionsMixin):
         bound, msg, bad = B.match_args(params, args)
         if msg:
             raise self.fail(f"{r_name}: {msg}", bad.span if bad else span)
-        for key, a in list(bound.items()):
-            if a.conditional:
-                cell = f.vars.get(a.value.key)  # type: ignore[union-attr]
-                if cell is None or cell.get() is ABSENT:
-                    del bound[key]
+        if any(a.conditional for a in args):
+            for key, a in list(bound.items()):
+                if a.conditional:
+                    cell = f.vars.get(a.value.key)  # type: ignore[union-attr]
+                    if cell is None or cell.get() is ABSENT:
+                        del bound[key]
         return bound
 
     def bind(self, r_name: str, params: list[n.Param], args: list[n.Arg], f: Frame, span: Span,
@@ -442,8 +441,6 @@ class Interpreter(InstructionsMixin):
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise self.fail(f"type mismatch: unary {e.op} needs a num, found {describe_type(v)}", e.operand.span)
             return -v if e.op == "-" else v
-        if isinstance(e, n.Binary):
-            return self.binary(e, f)
         if isinstance(e, n.Call):
             return self.call_function(e, f)
         raise self.fail(f"cannot evaluate {type(e).__name__}", e.span)  # pragma: no cover

@@ -84,20 +84,19 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
 
     def tick(now: int) -> bool:
         """Tick the controller; True when it only went round a loop that changed nothing."""
-        before, changes = ctl.wait, ctl.interp.changes
+        before, changes_before = ctl.wait, ctl.interp.changes
         ctl.tick_ns(now)
         after = ctl.wait
         return (ctl.state == WAITING and before is not None and after is not None and before.kind == "step"
                 and after.kind == "step" and after.span == before.span and after.what == before.what
-                and ctl.interp.changes == changes)
+                and ctl.interp.changes == changes_before)
 
     now = 0
     apply(now)
     idle = tick(now)
     while not ctl.finished:
-        wake = None if idle else ctl.next_wake_ns()  # an idle loop: only an input or a pulse can matter
-        if idle and ctl.interp.pulses:
-            wake = min(p[0] for p in ctl.interp.pulses)
+        # an idle loop: only an input or a pulse can matter
+        wake = min((p[0] for p in ctl.interp.pulses), default=None) if idle else ctl.next_wake_ns()
         times = [t for t in (wake, pending[0][0] if pending else None) if t is not None]
         if idle and not times:
             now = limit if limit is not None else fallback

@@ -11,6 +11,7 @@ from .errors import ExecError, Span
 from .values import RECORDS, array_type, base_type, split_array_type
 
 NS = 1_000_000_000
+DEFAULT_LOOP_BUDGET = 10_000  # time-less loop iterations per tick (Controller, Interpreter)
 
 
 def to_ns(seconds: float) -> int:

@@ -33,14 +33,15 @@ from twin.core.signals import BOOL, FLOAT, INPUT, INT, OUTPUT, SignalSpec
 from twin.core.station import ControllerSpec
 
 from .builtins import ERRORS
-from .controller import Controller, load_program
+from .controller import ERROR, RUNNING, WAITING, Controller, load_program
 from .errors import ExecError
 from .host import MotionRequest, SignalInfo
 from .values import Record, record
 
 SIGNAL_TYPE = {"DI": BOOL, "DO": BOOL, "AI": FLOAT, "AO": FLOAT, "GI": INT, "GO": INT}
 # The program's own signals, after the configured I/O: start and stop it from outside, see how it runs.
-START, STOP, RUNNING, ERROR, LINE = "rapid.start", "rapid.stop", "rapid.running", "rapid.error", "rapid.line"
+SIGNAL_START, SIGNAL_STOP, SIGNAL_RUNNING, SIGNAL_ERROR, SIGNAL_LINE = (
+    "rapid.start", "rapid.stop", "rapid.running", "rapid.error", "rapid.line")
 STATION_LOOP_BUDGET = 200  # time-less loop iterations per simulation step (see the module docstring)
 
 
@@ -193,30 +194,30 @@ class ControllerDevice:
                                     sig.unit, description=f"robot controller {sig.type} {sig.name} ({_wiring(sig)})",
                                     group="controller"))
         specs += [
-            SignalSpec(START, INPUT, BOOL, group="controller",
+            SignalSpec(SIGNAL_START, INPUT, BOOL, group="controller",
                        description="a rising edge (re)starts the RAPID program from its entry routine (VAR data anew, PERS kept)"),
-            SignalSpec(STOP, INPUT, BOOL, group="controller", description="a rising edge stops the RAPID program where it is"),
-            SignalSpec(RUNNING, OUTPUT, BOOL, group="controller", description="the RAPID program is running (or waiting)"),
-            SignalSpec(ERROR, OUTPUT, BOOL, group="controller",
+            SignalSpec(SIGNAL_STOP, INPUT, BOOL, group="controller", description="a rising edge stops the RAPID program where it is"),
+            SignalSpec(SIGNAL_RUNNING, OUTPUT, BOOL, group="controller", description="the RAPID program is running (or waiting)"),
+            SignalSpec(SIGNAL_ERROR, OUTPUT, BOOL, group="controller",
                        description="the RAPID program stopped on a runtime error (the server's log says where)"),
-            SignalSpec(LINE, OUTPUT, INT, min=0, max=65535, group="controller",
+            SignalSpec(SIGNAL_LINE, OUTPUT, INT, min=0, max=65535, group="controller",
                        description="the line of the program's module the robot controller waits at (0: none)"),
         ]
         self.signals = tuple(specs)
-        self._requests = {START: False, STOP: False}  # as written
+        self._requests = {SIGNAL_START: False, SIGNAL_STOP: False}  # as written
         self._seen = dict(self._requests)  # as acted on
 
     def read(self, name: str):
         if name in self._requests:
             return self._requests[name]
         state = self.controller.state
-        if name == RUNNING:
-            return state in ("running", "waiting")
-        if name == ERROR:
-            return state == "error"
-        if name == LINE:
+        if name == SIGNAL_RUNNING:
+            return state in (RUNNING, WAITING)
+        if name == SIGNAL_ERROR:
+            return state == ERROR
+        if name == SIGNAL_LINE:
             wait = self.controller.wait
-            return wait.span.line if wait is not None and wait.span is not None and state == "waiting" else 0
+            return wait.span.line if wait is not None and wait.span is not None and state == WAITING else 0
         value = self.host.read_signal(name)
         kind = SIGNAL_TYPE[self.host.io[name].type]
         return bool(value) if kind == BOOL else int(value) if kind == INT else value
@@ -231,7 +232,7 @@ class ControllerDevice:
         """Act on program requests written since the last step (rising edges), then run the program."""
         for name, value in self._requests.items():
             if value and not self._seen[name]:
-                self.controller.stop() if name == STOP else self.controller.start()
+                self.controller.stop() if name == SIGNAL_STOP else self.controller.start()
             self._seen[name] = value
         self.controller.tick(twin.time)
 

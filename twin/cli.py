@@ -61,8 +61,7 @@ def cmd_info(args) -> int:
             print("  ".join("-" * w for w in widths))
     for m in mech.mimics:
         print(f"mimic: {m.joint} follows {m.master} (x{m.multiplier:g} {m.offset:+g}), no input of its own")
-    print(f"fingers ({len(mech.fingers)}): " + ", ".join(
-        f.name + (f" (+{', '.join(f.links[1:])})" if len(f.links) > 1 else "") for f in mech.fingers))
+    print(f"fingers ({len(mech.fingers)}): " + ", ".join(f.label for f in mech.fingers))
     for line in _remarks(mech):
         print(line)
     return 0

@@ -60,6 +60,19 @@ class Script:
                  f" at {value * 1000:.0f} mm (finger forces: {forces})")
         return ok
 
+    def carry(self, pick: str, place: str, inside: bool, ready: float) -> bool:
+        """Half a cycle from above the `pick` pallet: fingers ready, down, grip, up, over to the `place` pallet,
+        down, release, up. True when the grip held."""
+        self.fingers_to(ready)
+        self.move("MoveL", f"grip_{pick}", 0.5)
+        gripped = self.grip(inside)
+        self.move("MoveL", f"app_{pick}", 0.5)
+        self.move("MoveJ", f"app_{place}", 2.0)
+        self.move("MoveL", f"grip_{place}", 0.5)
+        self.release(inside)
+        self.move("MoveL", f"app_{place}", 0.5)
+        return gripped
+
     def release(self, inside: bool) -> None:
         value = self.step_fingers_until(-1 if inside else +1, False, 0.0 if inside else 0.441)
         self.say(f"released at {value * 1000:.0f} mm")
@@ -78,7 +91,8 @@ def check_ring_rig(station: Station) -> None:
     targets = [t for t in ROBOT_TARGETS if t not in station.robot_targets]
     if targets:
         missing.append("robot targets " + ", ".join(targets))
-    inputs = [name for name in FINGERS if name not in {i.name for i in gripper_mechanism(station).inputs}]
+    have = {i.name for i in gripper_mechanism(station).inputs}
+    inputs = [name for name in FINGERS if name not in have]
     if inputs:
         missing.append("gripper inputs " + ", ".join(inputs))
     if missing:
@@ -101,23 +115,9 @@ def run_demo(station: str | Path, cycles: int = 1) -> int:
         for cycle in range(1, cycles + 1):
             s.say(f"cycle {cycle}: pick from outside on the right pallet")
             s.move("MoveJ", "app_right", 2.0)
-            s.fingers_to(0.330)
-            s.move("MoveL", "grip_right", 0.5)
-            misses += not s.grip(inside=False)
-            s.move("MoveL", "app_right", 0.5)
-            s.move("MoveJ", "app_left", 2.0)
-            s.move("MoveL", "grip_left", 0.5)
-            s.release(inside=False)
-            s.move("MoveL", "app_left", 0.5)
+            misses += not s.carry("right", "left", inside=False, ready=0.330)
             s.say(f"cycle {cycle}: pick from inside on the left pallet")
-            s.fingers_to(0.150)
-            s.move("MoveL", "grip_left", 0.5)
-            misses += not s.grip(inside=True)
-            s.move("MoveL", "app_left", 0.5)
-            s.move("MoveJ", "app_right", 2.0)
-            s.move("MoveL", "grip_right", 0.5)
-            s.release(inside=True)
-            s.move("MoveL", "app_right", 0.5)
+            misses += not s.carry("left", "right", inside=True, ready=0.150)
         end = twin.object_pose("ring")[0]
         error = math.dist(start, end)
         print(f"summary: {cycles} cycle(s), {2 * cycles - misses} grips, {misses} misses, "

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import PYBULLET_DATA, STATIONS
-from tests.core.urdfs import joint, link, station, two_jaws, urdf
+from tests.core.urdfs import block_and_floor, joint, link, station, two_jaws, urdf
 from twin.core import Twin
 from twin.core.errors import StationError
 from twin.core.station import load_station
@@ -34,17 +34,7 @@ tcp = { xyz = [0.0, 0.0, 0.35] }
 always_active = true
 {gripper_extra}
 
-[[targets]]
-name = "block"
-shape = "box"
-size = [0.03, 0.03, 0.04]
-xyz = [1.6, 0.0, 0.02]
-density = 1000.0
-
-[[fixtures]]
-name = "floor"
-shape = "plane"
-"""
+""" + block_and_floor("1.6, 0.0, 0.02")
 
 
 def robot_station(tmp_path, arm=ARM, robot_extra="", gripper=None, gripper_extra=""):

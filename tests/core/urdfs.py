@@ -29,6 +29,21 @@ def two_jaws(path: Path, a: str = "jaw_a", b: str = "jaw_b", collision: bool = T
                 joint("jb", "prismatic", "palm", b, extra='<mimic joint="ja"/>', axis="-1 0 0"), link(b, collision))
 
 
+def block_and_floor(xyz: str) -> str:
+    """The station tail every test station shares: a 30 x 30 x 40 mm block (the target) at `xyz`, a floor."""
+    return f"""[[targets]]
+name = "block"
+shape = "box"
+size = [0.03, 0.03, 0.04]
+xyz = [{xyz}]
+density = 1000.0
+
+[[fixtures]]
+name = "floor"
+shape = "plane"
+"""
+
+
 STATION = """[station]
 name = "t"
 
@@ -38,17 +53,7 @@ mount = { xyz = [0.0, 0.0, 0.3], rpy_deg = [180.0, 0.0, 0.0] }
 always_active = true
 {gripper_extra}
 
-[[targets]]
-name = "block"
-shape = "box"
-size = [0.03, 0.03, 0.04]
-xyz = [0.0, 0.0, 0.02]
-density = 1000.0
-
-[[fixtures]]
-name = "floor"
-shape = "plane"
-"""
+""" + block_and_floor("0.0, 0.0, 0.02")
 
 
 def station(folder: Path, gripper_urdf: Path, gripper_extra: str = "", text: str | None = None) -> Path:

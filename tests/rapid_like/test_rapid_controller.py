@@ -62,36 +62,30 @@ def test_a_time_less_loop_runs_its_budget_then_yields_at_every_tick():
     assert ctl.interp.globals["n"].value == 10_000  # the default budget
 
 
-def test_a_loop_within_the_budget_takes_no_time():
-    ctl, _, events = make("""
+SUM_TO_1000 = """
         MODULE M
           PROC main()
             VAR num sum := 0;
             FOR i FROM 1 TO 1000 DO
               sum := sum + i;
             ENDFOR
-            TPWrite "sum=" \\Num:=sum;
+            TPWrite "sum=" \\Num:=sum;{more}
+          ENDPROC
+        ENDMODULE"""
+
+
+def test_a_loop_within_the_budget_takes_no_time():
+    ctl, _, events = make(SUM_TO_1000.replace("{more}", """
             FOR i FROM 1 TO 3 DO
               TPWrite "i=" \\Num:=i;
-            ENDFOR
-          ENDPROC
-        ENDMODULE""")
+            ENDFOR"""))
     ctl.tick(0.0)
     assert ctl.state == "completed"
     assert prints(events) == [(0.0, "sum=500500"), (0.0, "i=1"), (0.0, "i=2"), (0.0, "i=3")]
 
 
 def test_a_loop_longer_than_the_budget_goes_on_at_the_next_ticks():
-    ctl, _, events = make("""
-        MODULE M
-          PROC main()
-            VAR num sum := 0;
-            FOR i FROM 1 TO 1000 DO
-              sum := sum + i;
-            ENDFOR
-            TPWrite "sum=" \\Num:=sum;
-          ENDPROC
-        ENDMODULE""", loop_budget=300)
+    ctl, _, events = make(SUM_TO_1000.replace("{more}", ""), loop_budget=300)
     k = 0
     while ctl.state != "completed":
         ctl.tick(k * DT)

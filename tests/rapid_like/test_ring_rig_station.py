@@ -69,23 +69,26 @@ def test_init_waits_for_a_path_signal_like_the_io_simulator():
         assert twin.read("diGripped") and twin.read("GrippedPart") == "ring"
 
 
-def copy_rig(tmp_path):
+def copy_rig(tmp_path, old: str | None = None, new: str | None = None):
+    """A copy of the rig in `tmp_path`, its station.toml with `old` replaced by `new`."""
     shutil.copytree(STATIONS / "robots", tmp_path / "robots")
-    return shutil.copytree(RIG, tmp_path / "rig")
+    station = shutil.copytree(RIG, tmp_path / "rig")
+    if old is not None:
+        toml = station / "station.toml"
+        text = toml.read_text()
+        assert old in text
+        toml.write_text(text.replace(old, new))
+    return station
 
 
 def test_wiring_to_a_signal_the_twin_lacks_names_the_file_and_key(tmp_path):
-    station = copy_rig(tmp_path)
-    toml = station / "station.toml"
-    toml.write_text(toml.read_text().replace('drives = "L3"', 'drives = "L9"'))
+    station = copy_rig(tmp_path, 'drives = "L3"', 'drives = "L9"')
     with pytest.raises(StationError, match=r"station\.toml: controller\.io\[7\]\.drives: aoAxis2: the twin has no signal 'L9'"):
         open_cell(station)
 
 
 def test_an_output_of_the_twin_cannot_be_driven(tmp_path):
-    station = copy_rig(tmp_path)
-    toml = station / "station.toml"
-    toml.write_text(toml.read_text().replace('drives = "L3"', 'drives = "doGripped"'))
+    station = copy_rig(tmp_path, 'drives = "L3"', 'drives = "doGripped"')
     with pytest.raises(StationError, match=r"controller\.io\[7\]\.drives: aoAxis2: 'doGripped' is an output"):
         open_cell(station)
 
@@ -159,9 +162,7 @@ def test_the_robots_outputs_are_read_only_from_outside_and_its_inputs_writable()
 
 
 def test_settable_is_only_for_outputs_that_drive_nothing(tmp_path):
-    station = copy_rig(tmp_path)
-    toml = station / "station.toml"
-    toml.write_text(toml.read_text().replace('name = "diGripped"\ntype = "DI"\n', 'name = "diGripped"\ntype = "DI"\nsettable = true\n'))
+    station = copy_rig(tmp_path, 'name = "diGripped"\ntype = "DI"\n', 'name = "diGripped"\ntype = "DI"\nsettable = true\n')
     with pytest.raises(StationError, match=r"controller\.io\[5\]\.settable"):
         open_cell(station)
 

@@ -86,10 +86,12 @@ class Gripper:
         master_input = {inp.joint: inp.name for inp in mechanism.inputs}
         self.mimics = [(joint_index[m.joint], master_input[m.master], m.multiplier, m.offset) for m in mechanism.mimics]
         self.finger_links = {f.name: [link_index[n] for n in f.links] for f in mechanism.fingers}
-        self.finger_joint = {f.name: joint_index[f.joint] for f in mechanism.fingers}
-        driven = set(self.joint.values()) | {m[0] for m in self.mimics}
-        # the driven joints that carry each finger, its own first: a finger presses with the servos behind it
-        self.finger_servos = {f: [j for j in self._chain(joint) if j in driven] for f, joint in self.finger_joint.items()}
+        # the servos (inputs) that drive each finger: those of the joints that carry it, a mimic joint's being
+        # its master's (a linkage has one motor); a finger presses with the servos behind it
+        servo_of = {j: name for name, j in self.joint.items()} | {j: master for j, master, _, _ in self.mimics}
+        self.finger_servos = {f.name: list(dict.fromkeys(servo_of[j] for j in self._chain(joint_index[f.joint])
+                                                          if j in servo_of))
+                              for f in mechanism.fingers}
         self.active_input = spec.always_active  # the `Active` input as last written
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
@@ -98,7 +100,6 @@ class Gripper:
         self.dt = float(params["fixedTimeStep"])
         # how far pybullet's motor trails a target moving at 1 unit/s: it asks for POSITION_GAIN * error / h
         self._lag_per_speed = self.dt / max(1, int(params["numSubSteps"])) / POSITION_GAIN
-        self._command_speed: dict[str, float] = {inp.name: 0.0 for inp in mechanism.inputs}
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
         self._held_at: dict[str, tuple[float, float]] = {}  # while a part is held: input -> (position, pressing sign)
@@ -157,7 +158,6 @@ class Gripper:
             if ahead > 0:
                 target = actual if abs(goal[name] - target) > abs(actual - target) else goal[name]
             speed = abs(target - self.command_position[name]) / dt
-            self._command_speed[name] = speed
             self.command_position[name] = target
             # a joint held back by a part (its lag beyond what its speed explains) may press with its whole effort:
             # pybullet's motor only pushes as hard as the velocity it asks for allows, so let it ask for more
@@ -177,29 +177,12 @@ class Gripper:
         c.changeConstraint(gear, gearRatio=-mult, relativePositionTarget=off, erp=MIMIC_ERP,
                            maxForce=MIMIC_FORCE_FACTOR * self.limits[master][1] * max(1.0, abs(mult)))
 
-    def _force(self, joint: int) -> float:
-        """The servo force of a joint after the step: effort * following error / full-force error. The lag that a
-        joint moving at its speed has behind its command (the motor's, not a load's) does not count; a joint
-        held by a part stands, so all of its error does."""
-        for j, master, _, _ in self.mimics:
-            if j == joint:  # a linkage has one motor: its master's, whose force every coupled finger feels
-                return self._force(self.joint[master])
-        actual, joint_speed = self.client.getJointState(self.body, joint)[:2]
-        command, _, effort, full_error = self._servo_of(joint)
-        error = max(0.0, abs(command - actual) - abs(joint_speed) * self._lag_per_speed)
-        return effort * min(1.0, error / full_error)
-
-    def _servo_of(self, joint: int) -> tuple[float, float, float, float]:
-        """(command position, its speed, effort limit, full-force error) of an input's or a mimic's joint."""
-        for name, j in self.joint.items():
-            if j == joint:
-                return (self.command_position[name], self._command_speed[name], self.limits[name][1],
-                        FULL_FORCE_ERROR[self.unit[name]])
-        for j, master, mult, off in self.mimics:
-            if j == joint:
-                return (mult * self.command_position[master] + off, abs(mult) * self._command_speed[master],
-                        self.limits[master][1], FULL_FORCE_ERROR[self.unit[master]] * abs(mult))
-        return 0.0, 0.0, 0.0, 1.0  # not driven
+    def _force(self, name: str, actual: float, joint_speed: float) -> float:
+        """The servo force of input `name` after the step: effort * following error / full-force error. The lag
+        that a joint moving at its speed has behind its command (the motor's, not a load's) does not count; a
+        joint held by a part stands, so all of its error does."""
+        error = max(0.0, abs(self.command_position[name] - actual) - abs(joint_speed) * self._lag_per_speed)
+        return self.limits[name][1] * min(1.0, error / FULL_FORCE_ERROR[self.unit[name]])
 
     def _chain(self, joint: int) -> list[int]:
         """`joint` and the joints between it and the body's base, nearest first."""
@@ -245,10 +228,10 @@ class Gripper:
         axes = {}
         for name, joint in self.joint.items():
             pos, vel, _, _ = c.getJointState(self.body, joint)
-            axes[name] = AxisState(pos, vel, self._force(joint))
+            axes[name] = AxisState(pos, vel, self._force(name, pos, vel))
         fingers = {}
         for finger, servos in self.finger_servos.items():
-            force = max((self._force(j) for j in servos), default=0.0)
+            force = max((axes[name].force for name in servos), default=0.0)
             fingers[finger] = FingerState(self._touching(finger), force)
         self.state.axes, self.state.fingers = axes, fingers
         common = set(self.targets)

@@ -24,7 +24,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from .errors import MotionError
 from .geometry import Pose, quat_conj, quat_mul
-from .world import quiet_native_stdout
+from ..native_output import quiet_native_output
 
 ARM_JOINTS = ("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6")
 
@@ -75,7 +75,7 @@ class ArmKinematics:
         self.base = Pose(base_position, base_orientation_xyzw)
         self.tool = tool if tool is not None else Pose.identity()
         self._tool_inv = self.tool.inverse()
-        with quiet_native_stdout():
+        with quiet_native_output():
             self.client = BulletClient(connection_mode=pybullet.DIRECT)
             self.body = self.client.loadURDF(str(self.urdf_path), self.base.position.tolist(),
                                              self.base.orientation.tolist(), useFixedBase=True,

@@ -20,6 +20,7 @@ It needs no physics connection, so `twin info` works on any URDF in milliseconds
 """
 from __future__ import annotations
 
+import functools
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -27,11 +28,15 @@ from pathlib import Path
 
 from .errors import MechanismError
 
+
+class FingerNameError(MechanismError):
+    """The names given for the fingers do not fit the URDF (they come from the station, not the URDF)."""
+
 MOVABLE = ("prismatic", "revolute", "continuous")
 NOT_DRIVEN = ("planar", "floating", "spherical")  # spherical: pybullet's extension; the twin makes these fixed
 RIGID = ("fixed",) + NOT_DRIVEN
 #: The twin's own signal names: a link named so would give a second signal of the same name.
-RESERVED_NAMES = ("Active", "doGripped", "GrippedPart")
+RESERVED_NAMES = ("Active", "doGripped", "GrippedPart")  # the twin's own signals (twin.Twin._signal_table)
 
 
 @dataclass(frozen=True)
@@ -66,6 +71,11 @@ class Finger:
     name: str
     joint: str
     links: tuple[str, ...]
+
+    @property
+    def label(self) -> str:
+        """Its name, with the links fixed to it: `F1 (+F1_tip)`."""
+        return self.name + (f" (+{', '.join(self.links[1:])})" if len(self.links) > 1 else "")
 
 
 @dataclass(frozen=True)
@@ -175,8 +185,27 @@ def _parse(urdf: Path) -> tuple[str, dict[str, bool], list[_Joint]]:
 
 
 def load_mechanism(urdf: str | Path, finger_names: tuple[str, ...] | None = None) -> Mechanism:
-    """Read a gripper URDF into a Mechanism. `finger_names` overrides finger detection."""
+    """Read a gripper URDF into a Mechanism. `finger_names` overrides finger detection.
+
+    A Mechanism is immutable and a pure function of the file and the names, so a file read before and
+    unchanged since (same modification time and size) is not parsed again: loading a station, checking it
+    and building its twin all ask for the same one."""
     urdf = Path(urdf)
+    names = None if finger_names is None else tuple(finger_names)
+    try:
+        st = urdf.stat()
+    except OSError:
+        return _load_mechanism(urdf, names)  # the parse reports what is wrong with the path
+    return _load_unchanged(urdf, urdf.resolve(), st.st_mtime_ns, st.st_size, names)
+
+
+@functools.lru_cache(maxsize=32)
+def _load_unchanged(urdf: Path, resolved: Path, mtime_ns: int, size: int,
+                    finger_names: tuple[str, ...] | None) -> Mechanism:
+    return _load_mechanism(urdf, finger_names)  # messages name the file as the caller gave it
+
+
+def _load_mechanism(urdf: Path, finger_names: tuple[str, ...] | None) -> Mechanism:
     robot_name, links, joints = _parse(urdf)
     by_name = {j.name: j for j in joints}
     children = {j.child for j in joints}
@@ -293,12 +322,11 @@ def _named_fingers(urdf: Path, names: tuple[str, ...], candidates: tuple[Finger,
     for name in names:
         finger = owner.get(name)
         if finger is None:
-            known = ", ".join(f.name + (f" (+{', '.join(f.links[1:])})" if len(f.links) > 1 else "")
-                              for f in candidates)
-            raise MechanismError(f"{urdf}: finger {name!r} is not a link of a finger, i.e. a movable joint's child "
+            known = ", ".join(f.label for f in candidates)
+            raise FingerNameError(f"{urdf}: finger {name!r} is not a link of a finger, i.e. a movable joint's child "
                                  f"link or a link fixed to one (fingers: {known or 'none'})")
         if finger in fingers:
-            raise MechanismError(f"{urdf}: finger {name!r} is finger {finger.name!r}, which is already named")
+            raise FingerNameError(f"{urdf}: finger {name!r} is finger {finger.name!r}, which is already named")
         fingers.append(finger)
     return tuple(fingers)
 

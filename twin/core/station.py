@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import MechanismError, StationError
-from .mechanism import MOVABLE, Mechanism, load_mechanism, read_links_and_joints
+from .mechanism import MOVABLE, FingerNameError, Mechanism, load_mechanism, read_links_and_joints
 
 SHAPES = ("ring", "box", "cylinder", "plane")
 MAX_RING_SEGMENTS = 16
@@ -428,15 +428,12 @@ def gripper_mechanism(station: Station) -> Mechanism:
     """
     g, file = station.gripper, str(station.file)
     try:
-        mech = load_mechanism(g.urdf)
+        mech = load_mechanism(g.urdf, g.fingers)
+    except FingerNameError as exc:  # the URDF is fine; the station's finger names are not
+        raise StationError(file, "gripper.fingers", str(exc)) from None
     except MechanismError as exc:
         raise StationError(file, "gripper.urdf", str(exc)) from None
-    if g.fingers is not None:
-        try:
-            mech = load_mechanism(g.urdf, g.fingers)
-        except MechanismError as exc:
-            raise StationError(file, "gripper.fingers", str(exc)) from None
-    elif not mech.fingers:
+    if g.fingers is None and not mech.fingers:
         raise StationError(file, "gripper.urdf", f"{g.urdf.name} has no finger: no movable link (with the links fixed "
                                                  "to it) has collision geometry, so nothing could ever grip; name the "
                                                  "fingers with gripper.fingers")

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-
-import pybullet
 from typing import Protocol
 
 from .errors import MotionError, SignalError, StationError
@@ -106,6 +104,7 @@ class Twin:
             self.robot.reset([math.radians(a) for a in st.robot.home_deg])
         self._present = {f"{t.name}.present": True for t in st.targets}  # as written
         self._placed = dict(self._present)  # as applied to the world
+        self._target_of = {f"{t.name}.present": t for t in st.targets}
         self._outputs: dict[str, object] = {}
         self._publish()
 
@@ -360,7 +359,7 @@ class Twin:
         for key, want in self._present.items():
             if self._placed[key] == want:
                 continue
-            body = next(t for t in self.station.targets if f"{t.name}.present" == key)
+            body = self._target_of[key]
             uid, c = self.world.body_ids[body.name], self.world.client
             if not want:
                 if self.gripper.state.gripped == body.name:
@@ -369,6 +368,6 @@ class Twin:
                 c.changeDynamics(uid, -1, mass=0)
             else:
                 c.changeDynamics(uid, -1, mass=body.mass)
-                c.resetBasePositionAndOrientation(uid, body.pose.xyz, pybullet.getQuaternionFromEuler(body.pose.rpy))
+                c.resetBasePositionAndOrientation(uid, body.pose.xyz, quat(body.pose))
                 c.resetBaseVelocity(uid, [0, 0, 0], [0, 0, 0])
             self._placed[key] = want

@@ -13,10 +13,8 @@ planar, floating and spherical gripper joints made fixed, as the mechanism treat
 """
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import sys
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -27,41 +25,9 @@ from pybullet_utils.bullet_client import BulletClient
 from .errors import StationError
 from .mechanism import NOT_DRIVEN
 from .station import Body, Placement, Station
+from ..native_output import quiet_native_output
 
 ROBOT_PREFIX = "robot/"
-
-
-@contextlib.contextmanager
-def quiet_native_stdout():
-    """Silence what pybullet's C code prints on stdout (it would corrupt `--json` output)."""
-    fd = 1
-    try:
-        sys.stdout.flush()
-    except (AttributeError, ValueError, OSError):
-        pass
-    try:
-        saved = os.dup(fd)
-        devnull = os.open(os.devnull, os.O_WRONLY)
-    except OSError:
-        yield
-        return
-    try:
-        os.dup2(devnull, fd)
-        yield
-    finally:
-        _flush_c_stdio()  # what C code buffered meanwhile goes to /dev/null, not to the restored stdout
-        os.dup2(saved, fd)
-        os.close(saved)
-        os.close(devnull)
-
-
-def _flush_c_stdio() -> None:
-    try:
-        import ctypes
-
-        ctypes.CDLL(None).fflush(None)
-    except (OSError, AttributeError, TypeError):  # no C library to ask (e.g. Windows): nothing buffered there
-        pass
 
 
 def quat(p: Placement) -> tuple[float, float, float, float]:
@@ -127,25 +93,27 @@ def _read(urdf: Path, file: Path, key: str) -> ET.Element:
         raise StationError(str(file), key, f"{urdf}: cannot be read as a URDF: {exc}") from None
 
 
-def write_gripper(gripper_urdf: Path, file: Path, out_dir: Path) -> Path:
-    """The gripper's URDF as the world loads it when there is no robot: absolute mesh paths, rigid joints."""
+def _gripper_for_pybullet(gripper_urdf: Path, file: Path) -> ET.Element:
+    """The gripper's URDF as the world loads it: absolute mesh paths, joints that are not inputs rigid."""
     gripper = _read(gripper_urdf, file, "gripper.urdf")
     _absolutize_meshes(gripper, gripper_urdf, file, "gripper.urdf")
     _rigid_for_pybullet(gripper)
+    return gripper
+
+
+def write_gripper(gripper_urdf: Path, file: Path, out_dir: Path) -> Path:
+    """The gripper's URDF as the world loads it when there is no robot."""
     out = out_dir / "gripper.urdf"
-    ET.ElementTree(gripper).write(out)
+    ET.ElementTree(_gripper_for_pybullet(gripper_urdf, file)).write(out)
     return out
 
 
 def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper_urdf: Path, gripper_root: str,
-                             mount: Placement, out_dir: Path, file: Path | str = "station") -> Path:
+                             mount: Placement, out_dir: Path, file: Path) -> Path:
     """Write one URDF where the gripper's root link hangs off the robot's flange by a fixed joint."""
-    file = Path(file)
     robot = _read(robot_urdf, file, "robot.urdf")
-    gripper = _read(gripper_urdf, file, "gripper.urdf")
     _absolutize_meshes(robot, robot_urdf, file, "robot.urdf")
-    _absolutize_meshes(gripper, gripper_urdf, file, "gripper.urdf")
-    _rigid_for_pybullet(gripper)
+    gripper = _gripper_for_pybullet(gripper_urdf, file)
     for elem in robot:
         if elem.tag in ("link", "joint"):
             elem.set("name", ROBOT_PREFIX + elem.get("name", ""))
@@ -176,7 +144,7 @@ class World:
     def __init__(self, station: Station, gripper_root: str):
         self.station = station
         self._tmp = tempfile.TemporaryDirectory(prefix="gripper-twin-")
-        with quiet_native_stdout():
+        with quiet_native_output():  # pybullet's argv[0] lines would corrupt `--json` output
             self.client = BulletClient(connection_mode=pybullet.DIRECT)
             self._build(station, gripper_root)
 

@@ -23,14 +23,11 @@ import sys
 import traceback
 from collections.abc import Callable, Sequence
 
+from .log import log as _log
 from .register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, FAULT, HOLDING_REGISTER,
                            INPUT_REGISTER, LATE, LATE_STEPS, LOCKSTEP, MAP_CRC, MODE, SPEED_PCT, STEP, TIME_MS,
                            Entry, RegisterMap, map_crc)
 from .server import ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE, Images
-
-
-def _log(text: str) -> None:
-    print(f"twin serve: {text}", file=sys.stderr, flush=True)
 
 
 class TwinBridge:

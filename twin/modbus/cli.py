@@ -15,9 +15,7 @@ import signal
 import sys
 from pathlib import Path
 
-
-def _log(text: str) -> None:
-    print(f"twin serve: {text}", file=sys.stderr, flush=True)
+from .log import log as _log
 
 
 def open_twin(station, on_event=None):

@@ -59,7 +59,7 @@ RESERVED = 16  # addresses 0..15 of every table belong to the twin (sim.* and fa
 REFERENCE_BASE = {COIL: 1, DISCRETE_INPUT: 10001, INPUT_REGISTER: 30001, HOLDING_REGISTER: 40001}
 
 WIDTH = {"bool": 1, "uint16": 1, "int16": 1, "uint32": 2, "int32": 2, "float32": 2}
-_LIMITS = {"uint16": (0, 0xFFFF), "int16": (-0x8000, 0x7FFF), "uint32": (0, 0xFFFFFFFF),
+TYPE_LIMITS = {"uint16": (0, 0xFFFF), "int16": (-0x8000, 0x7FFF), "uint32": (0, 0xFFFFFFFF),
            "int32": (-0x80000000, 0x7FFFFFFF), "bool": (0, 1)}
 _STRUCT = {"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i", "float32": ">f"}
 
@@ -135,7 +135,7 @@ class Entry:
             lo = -math.inf if self.min is None else self.min
             hi = math.inf if self.max is None else self.max
             return lo, hi
-        tlo, thi = _LIMITS[self.type]
+        tlo, thi = TYPE_LIMITS[self.type]
         lo = tlo if self.min is None else max(tlo, math.ceil(self.min / self.scale - 1e-6))
         hi = thi if self.max is None else min(thi, math.floor(self.max / self.scale + 1e-6))
         return lo, hi
@@ -157,7 +157,7 @@ class Entry:
         v = float(value) * self.factor / self.scale
         if math.isnan(v):
             return 0
-        lo, hi = _LIMITS[self.type]
+        lo, hi = TYPE_LIMITS[self.type]
         if self.access == "r":  # an output a hair past its declared range (a finger pressed past its limit) reads as the limit
             if self.min is not None:
                 lo = max(lo, math.ceil(self.min / self.scale - 1e-9))
@@ -358,7 +358,7 @@ def _fit_type(lo_e: float | None, hi_e: float | None, scale: float, signed_defau
         return "int32" if (lo_e is None or lo_e < 0 or signed_default) else "uint32"
     lo, hi = math.ceil(lo_e / scale - 1e-6), math.floor(hi_e / scale + 1e-6)
     for t in ("uint16", "int16", "uint32", "int32"):
-        tlo, thi = _LIMITS[t]
+        tlo, thi = TYPE_LIMITS[t]
         if tlo <= lo and hi <= thi:
             return t
     return "float32"

@@ -53,11 +53,11 @@ from __future__ import annotations
 import asyncio
 import socket
 import struct
-import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
+from .log import log as _log
 from .register_map import BIT_TABLES, COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, TABLES, Entry, RegisterMap
 
 ILLEGAL_FUNCTION, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE = 0x01, 0x02, 0x03, 0x04
@@ -96,10 +96,6 @@ class Backend(Protocol):
 
     def live_holding(self, address: int) -> int | None:
         """A holding register whose value is live rather than from the last step (e.g. sim.advance)."""
-
-
-def _log(text: str) -> None:
-    print(f"twin serve: {text}", file=sys.stderr, flush=True)
 
 
 class _Table:
