@@ -129,6 +129,16 @@ class Gripper:
         self.check(self.mechanism.input(name), value)
         self.setpoint[name] = float(value)
 
+    def set_limits(self, name: str, velocity: float | None = None, effort: float | None = None) -> None:
+        """Change an input's velocity or effort limit from the next step on (a drive that loses force, a
+        slower axis: fault injection and parameter studies). None keeps the present value."""
+        old_velocity, old_effort = self.limits[self.mechanism.input(name).name]
+        for what, value in (("velocity", velocity), ("effort", effort)):
+            if value is not None and not (value >= 0.0 and value < float("inf")):
+                raise ValueError(f"{name}: the {what} limit must be a finite number >= 0, not {value!r}")
+        self.limits[name] = (old_velocity if velocity is None else float(velocity),
+                             old_effort if effort is None else float(effort))
+
     def set_active(self, active: bool) -> None:
         """Store the `Active` input; an always-active gripper keeps what was written but ignores it."""
         self.active_input = bool(active)

@@ -233,6 +233,26 @@ class Twin:
                 raise SignalError(name, f"needs a number, not {value!r}")
             self.gripper.set_setpoint(name, float(value))
 
+    def set_drive_limits(self, name: str, velocity: float | None = None, effort: float | None = None) -> None:
+        """Change input `name`'s velocity limit (m/s or rad/s) or effort limit (N or N*m) from the next step on
+        (a drive that loses force; parameter studies). None keeps the present value."""
+        self.spec(name)
+        self.gripper.set_limits(name, velocity, effort)
+
+    def drive_limits(self, name: str) -> tuple[float, float]:
+        """Input `name`'s (velocity, effort) limits as the gripper applies them now."""
+        self.spec(name)
+        return self.gripper.limits[name]
+
+    def override_outputs(self, values: dict) -> None:
+        """Replace published output values until the next step publishes anew: a sensor reading that is stuck
+        or offset, injected by a device in `after_step`. Readers (the PLC, the servers) see the replaced
+        values; the gripper's own logic and the physics do not."""
+        for name in values:
+            if self.spec(name).direction != OUTPUT:
+                raise SignalError(name, "is an input: only outputs (readings) can be overridden")
+        self._outputs = {**self._outputs, **values}
+
     def _publish(self) -> None:
         g, out = self.gripper.state, {}
         out["doGripped"] = bool(g.gripped)
