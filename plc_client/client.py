@@ -174,7 +174,8 @@ def _check(s: Signal, value: Any) -> Any:
         return s.choices.index(value)
     if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
         raise SignalValueError(s.name, f"needs a number, not {value!r}")
-    if (s.min is not None and value < s.min) or (s.max is not None and value > s.max):
+    slack = 1e-9 * max(1.0, abs(s.min or 0.0), abs(s.max or 0.0))  # the map's limits carry 9 decimals: an exact end passes
+    if (s.min is not None and value < s.min - slack) or (s.max is not None and value > s.max + slack):
         raise ValueOutOfRangeError(s.name, value, s.min, s.max, s.unit)
     if s.type == "float32":
         if math.isinf(value) or abs(value) > FLOAT32_MAX:

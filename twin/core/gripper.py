@@ -126,7 +126,10 @@ class Gripper:
 
     def set_setpoint(self, name: str, value: float) -> None:
         """Validate and store a setpoint; it takes effect at the next step. Out of range: rejected."""
-        self.check(self.mechanism.input(name), value)
+        inp = self.mechanism.input(name)
+        slack = 1e-9 * max(1.0, abs(inp.min), abs(inp.max))  # a range end sent in other units (deg, mm) is the end
+        value = inp.max if inp.max < value <= inp.max + slack else inp.min if inp.min - slack <= value < inp.min else value
+        self.check(inp, value)
         self.setpoint[name] = float(value)
 
     def set_limits(self, name: str, velocity: float | None = None, effort: float | None = None) -> None:

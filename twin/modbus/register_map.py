@@ -135,9 +135,11 @@ class Entry:
             lo = -math.inf if self.min is None else self.min
             hi = math.inf if self.max is None else self.max
             return lo, hi
+        # the range's ends round inwards, but the count nearest an exact end (what a client writing the end
+        # itself sends, e.g. 0.9 rad = 51.566 deg as 5157 counts) is accepted too: it means the end
         tlo, thi = TYPE_LIMITS[self.type]
-        lo = tlo if self.min is None else max(tlo, math.ceil(self.min / self.scale - 1e-6))
-        hi = thi if self.max is None else min(thi, math.floor(self.max / self.scale + 1e-6))
+        lo = tlo if self.min is None else max(tlo, min(math.ceil(self.min / self.scale - 1e-6), round(self.min / self.scale)))
+        hi = thi if self.max is None else min(thi, max(math.floor(self.max / self.scale + 1e-6), round(self.max / self.scale)))
         return lo, hi
 
     # -- engineering value <-> words ------------------------------------------------------------------
