@@ -101,8 +101,9 @@ class TwinHost:
             if isinstance(value, str):  # an enum output (GrippedPart): its index, 0 for none
                 value = self.twin.spec(sig.source).choices.index(value)
             return (float(value) - sig.offset) / sig.scale
-        if sig.drives:
-            return self.outputs[name]
+        if sig.drives:  # a wired output reads what it drives (aoAxis1 mirrors L2, whoever wrote L2 last)
+            value = self.twin.read(sig.drives)
+            return (float(value) - sig.offset) / sig.scale
         return self.memory[name]
 
     def write_signal(self, name: str, value: float) -> None:

@@ -11,6 +11,21 @@ from typing import Callable
 from .core import Twin
 
 
+def add_watchdog(twin: Twin):
+    """The comm-loss watchdog (`twin.watchdog`), before the controller so a DI may read `comm.lost`."""
+    from .core.errors import StationError
+    from .watchdog import Watchdog
+
+    spec = twin.station.watchdog
+    names = {i.name for i in twin.mechanism.inputs}
+    for key in (spec.open if spec is not None else {}):
+        if key not in names:
+            raise StationError(str(twin.station.file), f"watchdog.open.{key}",
+                               f"not an input of the gripper (its inputs: {', '.join(sorted(names))})")
+    twin.watchdog = Watchdog.for_station(twin.station).attach(twin)
+    return twin.watchdog
+
+
 def open_cell(station: str | Path, on_event: Callable[[dict], None] | None = None, *,
               entry: str | None = None) -> Twin:
     """Load a station; if it has a `[controller]`, its RAPID program runs as the robot controller.
@@ -21,6 +36,7 @@ def open_cell(station: str | Path, on_event: Callable[[dict], None] | None = Non
     """
     twin = Twin.from_station(station)
     twin.controller = None
+    add_watchdog(twin)
     if twin.station.controller is not None:
         from rapid_like.station_host import attach_controller
 

@@ -202,7 +202,7 @@ def test_every_entry_of_the_exported_json_map_reads_back_at_its_address_with_its
         twin.step(steps)
         sim = {"sim.advance": 0, "sim.step": steps, "sim.time_ms": steps * 12, "sim.late_steps": 0,
                "sim.dt_us": 12000, "sim.mode": 0, "sim.speed_pct": 0, "fault": 0, "sim.lockstep": 1, "sim.late": 0,
-               "sim.map_crc": map_crc_of(ring_map)}
+               "sim.map_crc": map_crc_of(ring_map), "comm.lost": 0, "comm.watchdog_ms": 0}
         for e in ring_map:
             if e["name"] in sim:
                 assert got[e["name"]] == sim[e["name"]], e["name"]

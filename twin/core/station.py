@@ -120,6 +120,18 @@ class ControllerSpec:
 
 
 @dataclass(frozen=True)
+class WatchdogSpec:
+    """`[watchdog]`: the comm-loss watchdog (twin.watchdog): seconds of silence, and the safe state."""
+
+    timeout: float | None = None  # s; None: off unless `twin serve --watchdog S`
+    safe_state: str = "hold"  # hold, open or stop
+    open: dict[str, float] = field(default_factory=dict)  # open setpoints by input name (default: gripper.initial)
+
+
+SAFE_STATES = ("hold", "open", "stop")
+
+
+@dataclass(frozen=True)
 class Station:
     file: Path
     name: str
@@ -132,6 +144,7 @@ class Station:
     fixtures: tuple[Body, ...]
     robot_targets: dict[str, Placement]
     controller: ControllerSpec | None
+    watchdog: WatchdogSpec | None = None
 
     @property
     def folder(self) -> Path:
@@ -392,8 +405,23 @@ def load_station(path: str | Path) -> Station:
             io.append(sig)
         controller = ControllerSpec(cr.path_to("program"), cr.get("entry", str, "main"), tuple(io))
         cr.done()
+    watchdog = None
+    wr = top.sub("watchdog", required=False)
+    if wr is not None:
+        opened: dict[str, float] = {}
+        orr = wr.sub("open", required=False)
+        if orr is not None:
+            for key in list(orr.table):
+                opened[key] = orr.number(key)
+            orr.done()
+        watchdog = WatchdogSpec(wr.number("timeout", None, positive=True),
+                                wr.get("safe_state", str, "hold",
+                                       check=lambda v: None if v in SAFE_STATES else f"must be one of {', '.join(SAFE_STATES)}"),
+                                opened)
+        wr.done()
     top.done()
-    station = Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller)
+    station = Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller,
+                      watchdog)
     gripper_mechanism(station)  # the gripper's URDF and what the station says about it must agree
     return station
 

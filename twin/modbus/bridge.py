@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import dataclasses
 import struct
-import sys
 import traceback
 from collections.abc import Callable, Sequence
 
@@ -27,7 +26,7 @@ from .log import log as _log
 from .register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, FAULT, HOLDING_REGISTER,
                            INPUT_REGISTER, LATE, LATE_STEPS, LOCKSTEP, MAP_CRC, MODE, SPEED_PCT, STEP, TIME_MS,
                            Entry, RegisterMap, map_crc)
-from .server import ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE, Images
+from .pdu import ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE, Images
 
 
 class TwinBridge:
@@ -37,6 +36,7 @@ class TwinBridge:
         self.twin, self.map, self.log = twin, rmap, log
         self.runner = None  # set by whoever paces the twin (twin.pacing): mode, speed, late_steps, remaining
         self.fault = False
+        self.extra_status: dict[str, object] = {}  # values of sim.* entries the server's owner knows (comm.watchdog_ms)
         self._queue: list[Sequence[tuple[Entry, object]]] = []
         self._sizes = {t: rmap.size(t) for t in (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)}
         self._entries = {t: rmap.table(t) for t in self._sizes}
@@ -108,8 +108,8 @@ class TwinBridge:
             self.twin.step()
         except Exception as exc:  # a physics or device error: keep serving the last state, flag it
             self.fault = True
-            self.log(f"simulation fault at step {self.twin.step_count}: {type(exc).__name__}: {exc}")
-            traceback.print_exc(file=sys.stderr)
+            self.log(f"simulation fault at step {self.twin.step_count}: {type(exc).__name__}: {exc}\n"
+                     + traceback.format_exc().rstrip())
             self.publish()
             return False
         self.publish()
@@ -123,7 +123,7 @@ class TwinBridge:
             STEP: twin.step_count, TIME_MS: round(twin.time * 1000), DT_US: round(twin.dt * 1e6),
             LATE_STEPS: 0 if runner is None else runner.late_steps, MODE: 0 if lockstep else 1,
             SPEED_PCT: 0 if runner is None or lockstep else round(runner.speed * 100), ADVANCE: 0,
-            MAP_CRC: self.crc,
+            MAP_CRC: self.crc, **self.extra_status,
         }
 
     def publish(self) -> None:

@@ -76,6 +76,7 @@ ADVANCE, STEP, TIME_MS, LATE_STEPS, DT_US, MODE, SPEED_PCT, MAP_CRC = (
     "sim.advance", "sim.step", "sim.time_ms", "sim.late_steps", "sim.dt_us", "sim.mode", "sim.speed_pct",
     "sim.map_crc")
 FAULT, LOCKSTEP, LATE = "fault", "sim.lockstep", "sim.late"
+WATCHDOG_MS = "comm.watchdog_ms"
 
 
 class MapError(ValueError):
@@ -352,6 +353,9 @@ def _sim_entries() -> list[Entry]:
         E(MAP_CRC, INPUT_REGISTER, 10, 2, "uint32", 1.0, "", *u32, "r",
           "CRC-32 of this register map (name, table, address, count, type and scale of every other entry): "
           "a client compares it with the CRC of the map it was given"),
+        E(WATCHDOG_MS, INPUT_REGISTER, 12, 2, "uint32", 1.0, "ms", *u32, "r",
+          "the comm-loss watchdog's time (0: off): a client sends a request at least this often (a heartbeat), "
+          "else comm.lost rises and the gripper goes to the station's safe state"),
     ]
 
 

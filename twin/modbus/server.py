@@ -4,7 +4,9 @@ The server answers from register images (`Images`) that its backend publishes af
 simulation step, and hands validated writes to the backend (`Backend.submit`), which applies them at
 the start of the next step and shows them in the coil and holding-register images at once. So a read
 of an output always sees one completed step, a read of an input what was last written, and a write
-takes effect at the next step.
+takes effect at the next step. This module is the transport (MBAP framing on asyncio, plain TCP and
+Modbus/TCP Security over TLS), the fair share of the event loop, and who may connect; the PDUs are
+`pdu.py`'s.
 
 What is taken from pymodbus, and what is not
 --------------------------------------------
@@ -14,13 +16,11 @@ read gets exception 01 instead of 03, only the first of several pipelined reques
 frame has no timeout (the next request is glued onto it) and a wrong protocol id silences the
 connection. Its PDU decoder (`pymodbus.pdu.DecodePDU`) swallows the reason a request is bad (a count
 check raises and the decoder returns None), which is where the wrong codes come from. Its classic
-datastore is deprecated for v4. So the transport (MBAP framing on asyncio), the PDU codec for function
-codes 1, 2, 3, 4, 5, 6, 15, 16 and 23 (a few lines of `struct` each) and the checks are our own,
-written from the Modbus Application Protocol specification v1.1b3 and the Messaging on TCP/IP
-Implementation Guide v1.0b. pymodbus is used on the other side: the tests and the benchmark talk to
-this server with pymodbus's own clients (`ModbusTcpClient`, `AsyncModbusTcpClient`), so its (correct)
-client PDU encoder and decoder check our frames, and the benchmark's reference server is a bare
-pymodbus `ModbusTcpServer` on `SimDevice` (the v4 datastore). Tested with pymodbus >= 3.16, < 4.
+datastore is deprecated for v4. So the transport, the PDU codec and the checks are our own, written from
+the Modbus Application Protocol specification v1.1b3, the Messaging on TCP/IP Implementation Guide
+v1.0b and the Modbus/TCP Security protocol specification. pymodbus is used on the other side: the tests
+and the benchmark talk to this server with pymodbus's own clients, so its (correct) client PDU encoder
+and decoder check our frames. Tested with pymodbus >= 3.16, < 4.
 
 Wire behaviour
 --------------
@@ -31,300 +31,282 @@ Wire behaviour
   request that is merely over its function's quantity limit (e.g. function 16 with 124 registers,
   length 255) is framed and answered with exception 03 rather than dropped.
 - Requests on one connection are handled one after another and answered in order, however many are
-  pipelined before the first reply. A connection gets at most `requests_per_turn` requests answered
-  per turn of the event loop; with more pipelined, it stops reading and goes on at the next turn, so
-  one flooding client cannot starve the simulation runner or the other clients. A half frame that is
-  not completed within `frame_timeout` seconds closes that connection (the next request is never
-  glued onto it).
+  pipelined before the first reply. A half frame that is not completed within `frame_timeout` seconds
+  closes that connection (the next request is never glued onto it).
+- Fairness: all connections share one budget per step period (`requests_per_step` requests, and at
+  most `serve_share` of the period's wall time spent answering). Connections with complete requests
+  wait in a round-robin queue; each turn of the event loop answers a few requests of each in turn (a
+  connection that was idle goes before the ones with a backlog), so a client polling one request at a
+  time is answered within about one step period however many others flood the server, and the
+  simulation runner gets the loop between turns. A connection with a backlog is not read further
+  (TCP pushes back on its sender) until its backlog is answered.
 - Unit id: the server answers its `unit_id`, and 0 and 255 (which the TCP implementation guide uses for
   "this device"). Any other unit id gets exception 0B (gateway target device failed to respond).
 - Exceptions: the response's function code is the request's with the high bit set. An unknown function
-  gets 01; a quantity of 0 or above the limit (2000 bits, 125 registers to read; 1968 bits, 123
-  registers to write; 125/121 for function 23), a byte count that does not match the quantity, or a PDU
-  of the wrong length gets 03; an address range that leaves the map or touches a gap gets 02 (so does a
-  write that covers only part of a 32-bit value); a value outside the signal's range gets 03 and
-  changes nothing (a multi-register write is all or nothing); a write while the simulation is faulted
-  gets 04.
+  gets 01 (so does every write function with `read_only`); a quantity of 0 or above the limit (2000
+  bits, 125 registers to read; 1968 bits, 123 registers to write; 125/121 for function 23), a byte
+  count that does not match the quantity, or a PDU of the wrong length gets 03; an address range that
+  leaves the map or touches a gap gets 02 (reads across gaps read 0 with `gaps_zero`; so does a write
+  that covers only part of a 32-bit value); a value outside the signal's range gets 03 and changes
+  nothing (a multi-register write is all or nothing); a write while the simulation is faulted gets 04.
 - An accepted write shows at once when its coils or holding registers are read back (function 23
   writes, then reads); the twin applies it at the next step.
+
+Who may connect
+---------------
+`allow` (networks): a connection from any other address is closed at once and logged. `max_connections`:
+one more is refused (closed at once, logged); the ones already connected keep being served.
+`idle_timeout`: a connection with no complete request for that long is closed (logged). TLS
+(`start(..., ssl=context)`, built by `tls_context`): TLS 1.2 or later, client certificates required
+and checked against the CA; a client without one, or speaking plain Modbus/TCP, fails the handshake
+and is dropped.
 """
 from __future__ import annotations
 
 import asyncio
+import ipaddress
 import socket
+import ssl
 import struct
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Protocol
+import time
+from collections import deque
+from collections.abc import Callable, Iterable
 
 from .log import log as _log
-from .register_map import BIT_TABLES, COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, TABLES, Entry, RegisterMap
+from .pdu import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
+                  SERVER_DEVICE_FAILURE, Backend, DeviceIdentity, Images, PduHandler)
+from .register_map import RegisterMap
 
-ILLEGAL_FUNCTION, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE = 0x01, 0x02, 0x03, 0x04
-GATEWAY_TARGET_FAILED = 0x0B
-
-MAX_READ_BITS, MAX_READ_REGISTERS = 2000, 125
-MAX_WRITE_BITS, MAX_WRITE_REGISTERS = 1968, 123
-MAX_RW_READ, MAX_RW_WRITE = 125, 121
 MAX_LENGTH = 1 + 10 + 2 * 127  # MBAP length: unit id + function 23 writing 127 registers (byte count 254)
-REQUESTS_PER_TURN = 64  # pipelined requests answered per connection per event-loop turn
+REQUESTS_PER_STEP = 400  # global budget: requests answered per step period, over all connections
+SERVE_SHARE = 0.5  # at most this share of a step period's wall time goes to answering requests
+TURN_SECONDS = 0.002  # one turn of answering gives the loop back after this long
+QUANTUM = 8  # requests of one connection answered in a row before the next connection's turn
+MAX_CONNECTIONS = 64
+READ_BACKLOG = 16384  # bytes buffered per connection before it is no longer read
+TLS_PORT = 802  # Modbus/TCP Security's registered port (mbap/TLS)
 
 _HDR = struct.Struct(">HHHB")
-_AQ = struct.Struct(">HH")
 
 
-@dataclass(frozen=True)
-class Images:
-    """The four tables after one completed step: bits as bytes of 0/1, registers as big-endian bytes."""
-
-    coils: bytes
-    discrete_inputs: bytes
-    holding: bytes
-    input_registers: bytes
-
-
-class Backend(Protocol):
-    """What the server serves: published images, and a place to put validated writes."""
-
-    images: Images
-
-    def submit(self, changes: Sequence[tuple[Entry, object]]) -> int:
-        """Queue writes (entry, value in SI units) for the next step, all or nothing, and show them in
-        the coil / holding-register images at once. Returns 0, or a Modbus exception code (nothing queued)."""
-
-    live_addresses: frozenset[int]  # holding registers whose value is live (read through live_holding)
-
-    def live_holding(self, address: int) -> int | None:
-        """A holding register whose value is live rather than from the last step (e.g. sim.advance)."""
+def tls_context(cert: str, key: str, ca: str) -> ssl.SSLContext:
+    """A server context per the Modbus/TCP Security specification: TLS 1.2 or later, mutual
+    authentication (the client's certificate is required and must chain to `ca`)."""
+    ctx = ssl.SSLContext(ssl.PROTOCOL_TLS_SERVER)
+    ctx.minimum_version = ssl.TLSVersion.TLSv1_2
+    ctx.load_cert_chain(cert, key)
+    ctx.load_verify_locations(ca)
+    ctx.verify_mode = ssl.CERT_REQUIRED
+    return ctx
 
 
-class _Table:
-    """Address bookkeeping for one table: which addresses are mapped, where entries start."""
-
-    def __init__(self, rmap: RegisterMap, table: str):
-        self.size = rmap.size(table)
-        valid, starts, ends = bytearray(self.size + 1), bytearray(self.size + 1), bytearray(self.size + 1)
-        self.entry_at: dict[int, Entry] = {}
-        for e in rmap.table(table):
-            valid[e.address:e.end] = b"\x01" * e.count
-            starts[e.address] = 1
-            ends[e.end] = 1
-            self.entry_at[e.address] = e
-        self.valid, self.starts, self.ends = bytes(valid), bytes(starts), bytes(ends)
-
-    def readable(self, address: int, count: int) -> bool:
-        end = address + count
-        return end <= self.size and self.valid.find(0, address, end) == -1
-
-    def writable(self, address: int, count: int) -> bool:
-        return self.readable(address, count) and self.starts[address] == 1 and self.ends[address + count] == 1
-
-
-_ASCII_BITS = bytes.maketrans(b"\x00\x01", b"01")
-
-
-def _pack_bits(bits: bytes) -> bytes:
-    """Bytes of 0/1 -> Modbus bit packing (first bit in the low bit of the first byte)."""
-    if not bits:
-        return b""
-    return int(bits.translate(_ASCII_BITS)[::-1], 2).to_bytes((len(bits) + 7) // 8, "little")
+def parse_networks(text: str | Iterable[str]) -> tuple[ipaddress.IPv4Network | ipaddress.IPv6Network, ...]:
+    """`127.0.0.1,10.0.0.0/8` -> networks (a bare address is a /32 or /128). ValueError names the bad one."""
+    items = text.split(",") if isinstance(text, str) else list(text)
+    out = []
+    for item in items:
+        item = item.strip()
+        if not item:
+            continue
+        try:
+            out.append(ipaddress.ip_network(item, strict=False))
+        except ValueError:
+            raise ValueError(f"{item!r} is not an address or a network (CIDR, e.g. 192.168.0.0/24)") from None
+    if not out:
+        raise ValueError("no address or network given")
+    return tuple(out)
 
 
 class ModbusServer:
     """Serve `rmap` from `backend` over Modbus/TCP (see the module docstring)."""
 
     def __init__(self, rmap: RegisterMap, backend: Backend, *, unit_id: int = 1, frame_timeout: float = 1.0,
-                 requests_per_turn: int = REQUESTS_PER_TURN, log: Callable[[str], None] = _log):
+                 requests_per_step: int = REQUESTS_PER_STEP, step_period: float = 0.012,
+                 serve_share: float = SERVE_SHARE, max_connections: int = MAX_CONNECTIONS,
+                 idle_timeout: float | None = None, allow: Iterable | None = None, read_only: bool = False,
+                 gaps_zero: bool = False, identity: DeviceIdentity | None = None,
+                 on_request: Callable[[str], None] | None = None, log: Callable[[str], None] = _log,
+                 clock: Callable[[], float] = time.perf_counter):
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
         self.units = {unit_id, 0, 255}
+        self.pdus = PduHandler(rmap, backend, read_only=read_only, gaps_zero=gaps_zero, identity=identity)
         self.frame_timeout = frame_timeout
-        self.requests_per_turn = requests_per_turn
-        self.log = log
-        self.tables = {t: _Table(rmap, t) for t in TABLES}
+        self.requests_per_step, self.step_period, self.serve_share = requests_per_step, step_period, serve_share
+        self.max_connections, self.idle_timeout = max_connections, idle_timeout
+        self.allow = tuple(allow) if allow is not None else None
+        self.on_request = on_request
+        self.log, self.clock = log, clock
         self.connections: set[_Connection] = set()
-        self._server: asyncio.base_events.Server | None = None
-        self.requests = 0
+        self._servers: list[asyncio.base_events.Server] = []
+        self.refused = 0  # connections refused (allow list, limit)
+        # the fair share: connections with complete requests, and this step period's budget
+        self._fresh: deque[_Connection] = deque()  # were idle: answered first
+        self._backlog: deque[_Connection] = deque()
+        self._scheduled: asyncio.Handle | None = None
+        self._window, self._used, self._busy = 0.0, 0, 0.0
+        self._sweeper: asyncio.TimerHandle | None = None
 
-    async def start(self, host: str = "127.0.0.1", port: int = 5020) -> tuple[str, int]:
+    @property
+    def requests(self) -> int:
+        return self.pdus.requests
+
+    async def start(self, host: str = "127.0.0.1", port: int = 5020, *, ssl: ssl.SSLContext | None = None) -> tuple[str, int]:
+        """Listen on host:port (plain Modbus/TCP, or Modbus/TCP Security with `ssl`); may be called for both."""
         loop = asyncio.get_running_loop()
-        self._server = await loop.create_server(lambda: _Connection(self), host, port, reuse_address=True)
-        return self._server.sockets[0].getsockname()[:2]
+        kw = {"ssl": ssl, "ssl_handshake_timeout": max(1.0, 5 * self.frame_timeout)} if ssl is not None else {}
+        server = await loop.create_server(lambda: _Connection(self, tls=ssl is not None), host, port,
+                                          reuse_address=True, **kw)
+        self._servers.append(server)
+        if self.idle_timeout and self._sweeper is None:
+            self._sweep()
+        return server.sockets[0].getsockname()[:2]
 
     async def close(self) -> None:
-        if self._server is not None:
-            self._server.close()
-            for conn in list(self.connections):
-                conn.close("server stopping")
-            await self._server.wait_closed()
-            self._server = None
+        if self._sweeper is not None:
+            self._sweeper.cancel()
+            self._sweeper = None
+        for server in self._servers:
+            server.close()
+        for conn in list(self.connections):
+            conn.close("server stopping")
+        for server in self._servers:
+            await server.wait_closed()
+        self._servers = []
+
+    # -- who may connect -----------------------------------------------------------------------------
+    def admit(self, conn: "_Connection") -> str:
+        """'' to accept the connection, or why it is refused."""
+        if self.allow is not None:
+            try:
+                addr = ipaddress.ip_address(conn.address)
+            except ValueError:
+                return f"address {conn.address!r} not understood"
+            if addr.version == 6 and addr.ipv4_mapped is not None:
+                addr = addr.ipv4_mapped
+            if not any(addr in net for net in self.allow):
+                return "not in the allowed networks (--allow)"
+        if len(self.connections) >= self.max_connections:
+            return f"{len(self.connections)} connections already, the limit (--max-connections)"
+        return ""
+
+    def _sweep(self) -> None:
+        """Close connections idle longer than `idle_timeout`; runs every quarter of it (at most 1 s)."""
+        loop = asyncio.get_running_loop()
+        now = loop.time()
+        for conn in list(self.connections):
+            if now - conn.last_request >= self.idle_timeout and not conn.closed:
+                conn.close(f"idle for {self.idle_timeout:g} s (--idle-timeout)")
+        self._sweeper = loop.call_later(min(1.0, self.idle_timeout / 4), self._sweep)
 
     # -- requests -----------------------------------------------------------------------------------
     def handle(self, unit: int, pdu: bytes) -> bytes:
         """One request PDU -> its response PDU."""
-        self.requests += 1
-        fc = pdu[0]
         if unit not in self.units:
-            return bytes((fc | 0x80, GATEWAY_TARGET_FAILED))
-        try:
-            handler = self._HANDLERS[fc]
-        except KeyError:
-            return bytes((fc | 0x80, ILLEGAL_FUNCTION))
-        result = handler(self, pdu)
-        if isinstance(result, int):
-            return bytes((fc | 0x80, result))
-        return result
+            self.pdus.requests += 1
+            return bytes((pdu[0] | 0x80, GATEWAY_TARGET_FAILED))
+        return self.pdus.handle(pdu)
 
-    def _read_bits(self, pdu: bytes):
-        if len(pdu) != 5:
-            return ILLEGAL_DATA_VALUE
-        address, count = _AQ.unpack_from(pdu, 1)
-        if not 1 <= count <= MAX_READ_BITS:
-            return ILLEGAL_DATA_VALUE
-        table = COIL if pdu[0] == 1 else DISCRETE_INPUT
-        if not self.tables[table].readable(address, count):
-            return ILLEGAL_DATA_ADDRESS
-        images = self.backend.images
-        image = images.coils if table == COIL else images.discrete_inputs
-        data = _pack_bits(image[address:address + count])
-        return bytes((pdu[0], len(data))) + data
+    # -- the fair share ------------------------------------------------------------------------------
+    def want_turn(self, conn: "_Connection", fresh: bool) -> None:
+        (self._fresh if fresh else self._backlog).append(conn)
+        conn.queued = True
+        if self._scheduled is None:
+            self._scheduled = asyncio.get_running_loop().call_soon(self._serve)
 
-    def _read_registers(self, pdu: bytes):
-        if len(pdu) != 5:
-            return ILLEGAL_DATA_VALUE
-        address, count = _AQ.unpack_from(pdu, 1)
-        if not 1 <= count <= MAX_READ_REGISTERS:
-            return ILLEGAL_DATA_VALUE
-        data = self._registers(HOLDING_REGISTER if pdu[0] == 3 else INPUT_REGISTER, address, count)
-        if isinstance(data, int):
-            return data
-        return bytes((pdu[0], len(data))) + data
-
-    def _registers(self, table: str, address: int, count: int):
-        if not self.tables[table].readable(address, count):
-            return ILLEGAL_DATA_ADDRESS
-        images = self.backend.images
-        if table == INPUT_REGISTER:
-            return images.input_registers[2 * address:2 * (address + count)]
-        data = images.holding[2 * address:2 * (address + count)]
-        patched = None
-        for a in self.backend.live_addresses:
-            if address <= a < address + count:
-                v = self.backend.live_holding(a)
-                if v is not None:
-                    if patched is None:
-                        patched = bytearray(data)
-                    struct.pack_into(">H", patched, 2 * (a - address), v)
-        return data if patched is None else bytes(patched)
-
-    def _write(self, table: str, address: int, words: Sequence[int]) -> int:
-        """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code."""
-        t = self.tables[table]
-        if not t.writable(address, len(words)):
-            return ILLEGAL_DATA_ADDRESS
-        changes = []
-        a, end = address, address + len(words)
-        while a < end:
-            e = t.entry_at[a]
-            if not e.writable:
-                return ILLEGAL_DATA_ADDRESS
-            value = e.si_of_words(list(words[a - address:a - address + e.count]))
-            if value is None:
-                return ILLEGAL_DATA_VALUE
-            changes.append((e, value))
-            a += e.count
-        return self.backend.submit(changes)
-
-    def _write_coil(self, pdu: bytes):
-        if len(pdu) != 5:
-            return ILLEGAL_DATA_VALUE
-        address, value = _AQ.unpack_from(pdu, 1)
-        if value not in (0x0000, 0xFF00):
-            return ILLEGAL_DATA_VALUE
-        return self._write(COIL, address, [1 if value else 0]) or pdu
-
-    def _write_register(self, pdu: bytes):
-        if len(pdu) != 5:
-            return ILLEGAL_DATA_VALUE
-        address, value = _AQ.unpack_from(pdu, 1)
-        return self._write(HOLDING_REGISTER, address, [value]) or pdu
-
-    def _write_coils(self, pdu: bytes):
-        if len(pdu) < 6:
-            return ILLEGAL_DATA_VALUE
-        address, count = _AQ.unpack_from(pdu, 1)
-        nbytes = pdu[5]
-        if not 1 <= count <= MAX_WRITE_BITS or nbytes != (count + 7) // 8 or len(pdu) != 6 + nbytes:
-            return ILLEGAL_DATA_VALUE
-        bits = [(pdu[6 + (i >> 3)] >> (i & 7)) & 1 for i in range(count)]
-        return self._write(COIL, address, bits) or pdu[:5]
-
-    def _write_registers(self, pdu: bytes):
-        if len(pdu) < 6:
-            return ILLEGAL_DATA_VALUE
-        address, count = _AQ.unpack_from(pdu, 1)
-        nbytes = pdu[5]
-        if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(pdu) != 6 + nbytes:
-            return ILLEGAL_DATA_VALUE
-        words = struct.unpack_from(f">{count}H", pdu, 6)
-        return self._write(HOLDING_REGISTER, address, words) or pdu[:5]
-
-    def _read_write_registers(self, pdu: bytes):
-        if len(pdu) < 10:
-            return ILLEGAL_DATA_VALUE
-        raddr, rcount, waddr, wcount = struct.unpack_from(">HHHH", pdu, 1)
-        nbytes = pdu[9]
-        if (not 1 <= rcount <= MAX_RW_READ or not 1 <= wcount <= MAX_RW_WRITE or nbytes != 2 * wcount
-                or len(pdu) != 10 + nbytes):
-            return ILLEGAL_DATA_VALUE
-        if not self.tables[HOLDING_REGISTER].readable(raddr, rcount):
-            return ILLEGAL_DATA_ADDRESS
-        # The spec's order: the write first, then the read (which sees the write).
-        code = self._write(HOLDING_REGISTER, waddr, struct.unpack_from(f">{wcount}H", pdu, 10))
-        if code:
-            return code
-        data = self._registers(HOLDING_REGISTER, raddr, rcount)
-        return bytes((23, len(data))) + data
-
-    _HANDLERS = {1: _read_bits, 2: _read_bits, 3: _read_registers, 4: _read_registers, 5: _write_coil,
-                 6: _write_register, 15: _write_coils, 16: _write_registers, 23: _read_write_registers}
+    def _serve(self) -> None:
+        """One turn: answer connections round-robin, within this step period's budget."""
+        self._scheduled = None
+        clock = self.clock
+        now = clock()
+        if now >= self._window + self.step_period:
+            self._window, self._used, self._busy = now, 0, 0.0
+        budget = self.requests_per_step - self._used
+        time_left = min(TURN_SECONDS, self.serve_share * self.step_period - self._busy)
+        t0 = now
+        fresh, backlog = self._fresh, self._backlog
+        while (fresh or backlog) and budget > 0 and clock() - t0 < time_left:
+            conn = fresh.popleft() if fresh else backlog.popleft()
+            conn.queued = False
+            if conn.closed or conn.writing_paused:
+                continue
+            n = conn.answer(min(QUANTUM, budget))
+            budget -= n
+            self._used += n
+            if n and self.on_request is not None:
+                self.on_request(conn.peer)
+            if conn.has_request() and not conn.closed and not conn.writing_paused:
+                backlog.append(conn)
+                conn.queued = True
+        self._busy += clock() - t0
+        if fresh or backlog:
+            loop = asyncio.get_running_loop()
+            if budget <= 0 or self._busy >= self.serve_share * self.step_period:
+                delay = max(0.0, self._window + self.step_period - clock())
+                self._scheduled = loop.call_later(delay, self._serve)
+            else:
+                self._scheduled = loop.call_soon(self._serve)
 
 
 class _Connection(asyncio.Protocol):
-    """One client: MBAP framing, requests answered in order, a fair share of the loop, a timeout on half frames.
+    """One client: MBAP framing, requests answered in order when the scheduler gives it a turn, a
+    timeout on half frames. Reading stops (so TCP pushes back on the client) while the client does not
+    read its answers (`pause_writing`) and while its backlog is large."""
 
-    Reading stops (so TCP pushes back on the client) while the client does not read its answers
-    (`pause_writing`) and while complete requests wait for the next turn of the loop (`_later`)."""
-
-    def __init__(self, server: ModbusServer):
-        self.server = server
+    def __init__(self, server: ModbusServer, tls: bool = False):
+        self.server, self.tls = server, tls
         self.buf = bytearray()
         self.transport: asyncio.Transport | None = None
         self.timer: asyncio.TimerHandle | None = None
-        self._later: asyncio.Handle | None = None  # the next turn's share of pipelined requests
         self.writing_paused = False
+        self.reading_paused = False
+        self.queued = False
         self.closed = False
+        self.admitted = False
         self.peer = "?"
+        self.address = ""
         self.reason = ""
+        self.last_request = 0.0
 
     def connection_made(self, transport) -> None:
         self.transport = transport
+        self.last_request = asyncio.get_running_loop().time()
         sock = transport.get_extra_info("socket")
         if sock is not None:
-            try:
-                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            except OSError:
-                pass
+            for level, opt, value in ((socket.IPPROTO_TCP, socket.TCP_NODELAY, 1),
+                                      (socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1),
+                                      (socket.IPPROTO_TCP, getattr(socket, "TCP_KEEPIDLE", None), 10),
+                                      (socket.IPPROTO_TCP, getattr(socket, "TCP_KEEPINTVL", None), 5),
+                                      (socket.IPPROTO_TCP, getattr(socket, "TCP_KEEPCNT", None), 3)):
+                if opt is not None:
+                    try:
+                        sock.setsockopt(level, opt, value)
+                    except OSError:
+                        pass
         peer = transport.get_extra_info("peername")
-        self.peer = f"{peer[0]}:{peer[1]}" if peer else "?"
-        self.server.connections.add(self)
-        self.server.log(f"client {self.peer} connected ({len(self.server.connections)} connected)")
+        self.address = str(peer[0]) if peer else ""
+        self.peer = (f"[{peer[0]}]:{peer[1]}" if ":" in str(peer[0]) else f"{peer[0]}:{peer[1]}") if peer else "?"
+        server = self.server
+        why = server.admit(self)
+        if why:
+            server.refused += 1
+            self.closed = True
+            server.log(f"client {self.peer} refused: {why}")
+            transport.abort()
+            return
+        self.admitted = True
+        server.connections.add(self)
+        extra = ""
+        if self.tls:
+            cert = transport.get_extra_info("peercert") or {}
+            subject = dict(x[0] for x in cert.get("subject", ()) if x)
+            extra = f" over TLS as {subject.get('commonName', '?')!r}"
+        server.log(f"client {self.peer} connected{extra} ({len(server.connections)} connected)")
 
     def connection_lost(self, exc) -> None:
         self.closed = True
         self._stop_timer()
-        if self._later is not None:
-            self._later.cancel()
-            self._later = None
+        if not self.admitted:
+            return
         self.server.connections.discard(self)
         reason = self.reason or (f"error: {exc}" if exc else "closed by the client")
         self.server.log(f"client {self.peer} disconnected ({reason}; {len(self.server.connections)} connected)")
@@ -347,32 +329,59 @@ class _Connection(asyncio.Protocol):
     def pause_writing(self) -> None:  # the client does not read its answers: stop reading its requests
         self.writing_paused = True
         self._stop_timer()  # it cannot complete a half frame while we do not read
-        self.transport.pause_reading()
+        self._pause_reading()
 
     def resume_writing(self) -> None:
         self.writing_paused = False
-        if self._later is None and not self.closed:
-            self._later = asyncio.get_running_loop().call_soon(self._next_turn)
+        if self.closed:
+            return
+        if self.has_request():
+            if not self.queued:
+                self.server.want_turn(self, fresh=False)
+        else:
+            self._resume_reading()
+
+    def _pause_reading(self) -> None:
+        if not self.reading_paused and not self.closed:
+            self.reading_paused = True
+            self.transport.pause_reading()
+
+    def _resume_reading(self) -> None:
+        if self.reading_paused and not self.closed:
+            self.reading_paused = False
+            self.transport.resume_reading()
 
     def data_received(self, data: bytes) -> None:
+        if self.closed:
+            return
+        fresh = not self.buf
         self.buf += data
-        if self._later is None and not self.writing_paused:
-            self._answer()
+        if self.has_request():
+            self._stop_timer()
+            if not self.queued and not self.writing_paused:
+                self.server.want_turn(self, fresh=fresh)
+            if len(self.buf) >= READ_BACKLOG:
+                self._pause_reading()
+        elif self.timer is None:
+            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
 
-    def _next_turn(self) -> None:
-        self._later = None
-        if not self.closed and not self.writing_paused:
-            self._answer()
+    def has_request(self) -> bool:
+        """A complete frame (or a header that cannot be framed, to be refused) waits at the front."""
+        buf = self.buf
+        if len(buf) < 7:
+            return False
+        _, pid, length, _ = _HDR.unpack_from(buf, 0)
+        return pid != 0 or not 2 <= length <= MAX_LENGTH or len(buf) >= 6 + length
 
-    def _answer(self) -> None:
-        """Answer the complete requests at the front of the buffer, at most `requests_per_turn` of them."""
+    def answer(self, limit: int) -> int:
+        """Answer up to `limit` complete requests at the front of the buffer; returns how many."""
         buf = self.buf
         out = []
         pos, n = 0, len(buf)
         handle = self.server.handle
-        budget = self.server.requests_per_turn
+        count = 0
         bad = ""
-        while budget and n - pos >= 7:
+        while count < limit and n - pos >= 7:
             tid, pid, length, unit = _HDR.unpack_from(buf, pos)
             if pid != 0:
                 bad = f"protocol id {pid}, not 0 (Modbus)"
@@ -385,24 +394,20 @@ class _Connection(asyncio.Protocol):
             response = handle(unit, bytes(buf[pos + 7:pos + 6 + length]))
             out.append(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
             pos += 6 + length
-            budget -= 1
+            count += 1
         if pos:
             del buf[:pos]
-            self._stop_timer()
+            self.last_request = asyncio.get_running_loop().time()
         if out:
             self.transport.write(b"".join(out))  # may call pause_writing
         if bad:
             self._close_after_answers(bad)
-            return
-        if not budget and len(buf) >= 7:  # more may be waiting: the loop's other work first
-            self.transport.pause_reading()
-            if not self.writing_paused:
-                self._later = asyncio.get_running_loop().call_soon(self._next_turn)
-            return
-        if not self.writing_paused:
-            self.transport.resume_reading()
-            if buf and self.timer is None:
-                self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+            return count
+        if len(buf) < READ_BACKLOG and not self.writing_paused:
+            self._resume_reading()
+        if buf and not self.has_request() and self.timer is None and not self.writing_paused:
+            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+        return count
 
     def _stop_timer(self) -> None:
         if self.timer is not None:
@@ -411,4 +416,6 @@ class _Connection(asyncio.Protocol):
 
     def _stalled(self) -> None:
         self.timer = None
+        if self.has_request() or self.closed:
+            return
         self.close(f"half a frame ({len(self.buf)} bytes) not completed within {self.server.frame_timeout:g} s")

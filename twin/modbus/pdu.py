@@ -1,0 +1,317 @@
+"""The Modbus PDU codec: one request PDU in, its response PDU out. No sockets, no clock.
+
+Written from the Modbus Application Protocol specification v1.1b3: functions 1, 2, 3, 4, 5, 6, 15, 16,
+22 (mask write register, 6.16), 23 (read/write multiple registers, 6.17) and 43/14 (read device
+identification, 6.21). What each exception means here is listed in `server.py`'s docstring.
+"""
+from __future__ import annotations
+
+import struct
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from .register_map import COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, TABLES, Entry, RegisterMap
+
+ILLEGAL_FUNCTION, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE = 0x01, 0x02, 0x03, 0x04
+GATEWAY_TARGET_FAILED = 0x0B
+
+MAX_READ_BITS, MAX_READ_REGISTERS = 2000, 125
+MAX_WRITE_BITS, MAX_WRITE_REGISTERS = 1968, 123
+MAX_RW_READ, MAX_RW_WRITE = 125, 121
+WRITE_FUNCTIONS = frozenset({5, 6, 15, 16, 22, 23})
+MEI, MEI_DEVICE_ID = 0x2B, 0x0E
+MAX_PDU = 253
+
+_AQ = struct.Struct(">HH")
+
+
+@dataclass(frozen=True)
+class Images:
+    """The four tables after one completed step: bits as bytes of 0/1, registers as big-endian bytes."""
+
+    coils: bytes
+    discrete_inputs: bytes
+    holding: bytes
+    input_registers: bytes
+
+
+class Backend(Protocol):
+    """What the server serves: published images, and a place to put validated writes."""
+
+    images: Images
+
+    def submit(self, changes: Sequence[tuple[Entry, object]]) -> int:
+        """Queue writes (entry, value in SI units) for the next step, all or nothing, and show them in
+        the coil / holding-register images at once. Returns 0, or a Modbus exception code (nothing queued)."""
+
+    live_addresses: frozenset[int]  # holding registers whose value is live (read through live_holding)
+
+    def live_holding(self, address: int) -> int | None:
+        """A holding register whose value is live rather than from the last step (e.g. sim.advance)."""
+
+
+# -- device identification (6.21) ---------------------------------------------------------------------
+BASIC, REGULAR, EXTENDED, INDIVIDUAL = 1, 2, 3, 4
+VENDOR_NAME, PRODUCT_CODE, REVISION, VENDOR_URL, PRODUCT_NAME, MODEL_NAME, USER_APPLICATION_NAME = range(7)
+STATION_NAME_OBJECT = 0x80  # extended (private) objects: the station's name, the map's CRC-32
+MAP_CRC_OBJECT = 0x81
+
+
+@dataclass(frozen=True)
+class DeviceIdentity:
+    """What function 43/14 tells: the basic objects (vendor, product code, revision), the regular ones
+    and extended (private) objects 0x80.. (the station name, the register map's CRC)."""
+
+    vendor: str = "gripper-twin"
+    product_code: str = "GT-TWIN-SERVE"
+    revision: str = "0.1"
+    vendor_url: str = ""
+    product_name: str = "gripper-twin twin serve"
+    model_name: str = ""
+    user_application_name: str = ""
+    extended: Mapping[int, str] = field(default_factory=dict)
+
+    def objects(self) -> dict[int, bytes]:
+        objs = {VENDOR_NAME: self.vendor, PRODUCT_CODE: self.product_code, REVISION: self.revision,
+                VENDOR_URL: self.vendor_url, PRODUCT_NAME: self.product_name, MODEL_NAME: self.model_name,
+                USER_APPLICATION_NAME: self.user_application_name}
+        out = {k: v.encode("utf-8")[:MAX_PDU - 10] for k, v in objs.items() if k <= REVISION or v}
+        for k, v in sorted(self.extended.items()):
+            if 0x80 <= k <= 0xFF:
+                out[k] = v.encode("utf-8")[:MAX_PDU - 10]
+        return out
+
+
+def _category(object_id: int) -> int:
+    return BASIC if object_id <= 2 else REGULAR if object_id <= 0x7F else EXTENDED
+
+
+class _Table:
+    """Address bookkeeping for one table: which addresses are mapped, where entries start."""
+
+    def __init__(self, rmap: RegisterMap, table: str, gaps_zero: bool):
+        self.size = rmap.size(table)
+        valid, starts, ends = bytearray(self.size + 1), bytearray(self.size + 1), bytearray(self.size + 1)
+        self.entry_at: dict[int, Entry] = {}
+        for e in rmap.table(table):
+            valid[e.address:e.end] = b"\x01" * e.count
+            starts[e.address] = 1
+            ends[e.end] = 1
+            self.entry_at[e.address] = e
+        self.valid, self.starts, self.ends = bytes(valid), bytes(starts), bytes(ends)
+        self.gaps_zero = gaps_zero
+
+    def readable(self, address: int, count: int) -> bool:
+        end = address + count
+        return end <= self.size and (self.gaps_zero or self.valid.find(0, address, end) == -1)
+
+    def writable(self, address: int, count: int) -> bool:
+        end = address + count
+        return (end <= self.size and self.valid.find(0, address, end) == -1 and self.starts[address] == 1
+                and self.ends[end] == 1)
+
+
+_ASCII_BITS = bytes.maketrans(b"\x00\x01", b"01")
+
+
+def pack_bits(bits: bytes) -> bytes:
+    """Bytes of 0/1 -> Modbus bit packing (first bit in the low bit of the first byte)."""
+    if not bits:
+        return b""
+    return int(bits.translate(_ASCII_BITS)[::-1], 2).to_bytes((len(bits) + 7) // 8, "little")
+
+
+class PduHandler:
+    """Answers request PDUs for one register map from one backend.
+
+    `read_only`: every write function (5, 6, 15, 16, 22, 23) gets exception 01 and changes nothing.
+    `gaps_zero`: reads across unmapped addresses inside a table read 0 (writes there still get 02)."""
+
+    def __init__(self, rmap: RegisterMap, backend: Backend, *, read_only: bool = False, gaps_zero: bool = False,
+                 identity: DeviceIdentity | None = None):
+        self.map, self.backend = rmap, backend
+        self.read_only, self.gaps_zero = read_only, gaps_zero
+        self.tables = {t: _Table(rmap, t, gaps_zero) for t in TABLES}
+        self.identity = identity or DeviceIdentity()
+        self.id_objects = self.identity.objects()
+        self.requests = 0
+        self.refused_writes = 0
+
+    def handle(self, pdu: bytes) -> bytes:
+        """One request PDU -> its response PDU (an exception: the function code | 0x80 and the code)."""
+        self.requests += 1
+        fc = pdu[0]
+        try:
+            handler = self._HANDLERS[fc]
+        except KeyError:
+            return bytes((fc | 0x80, ILLEGAL_FUNCTION))
+        if self.read_only and fc in WRITE_FUNCTIONS:
+            self.refused_writes += 1
+            return bytes((fc | 0x80, ILLEGAL_FUNCTION))
+        result = handler(self, pdu)
+        if isinstance(result, int):
+            return bytes((fc | 0x80, result))
+        return result
+
+    # -- reads ----------------------------------------------------------------------------------------
+    def _read_bits(self, pdu: bytes):
+        if len(pdu) != 5:
+            return ILLEGAL_DATA_VALUE
+        address, count = _AQ.unpack_from(pdu, 1)
+        if not 1 <= count <= MAX_READ_BITS:
+            return ILLEGAL_DATA_VALUE
+        table = COIL if pdu[0] == 1 else DISCRETE_INPUT
+        if not self.tables[table].readable(address, count):
+            return ILLEGAL_DATA_ADDRESS
+        images = self.backend.images
+        image = images.coils if table == COIL else images.discrete_inputs
+        data = pack_bits(image[address:address + count])  # gaps are 0 in the image
+        return bytes((pdu[0], len(data))) + data
+
+    def _read_registers(self, pdu: bytes):
+        if len(pdu) != 5:
+            return ILLEGAL_DATA_VALUE
+        address, count = _AQ.unpack_from(pdu, 1)
+        if not 1 <= count <= MAX_READ_REGISTERS:
+            return ILLEGAL_DATA_VALUE
+        data = self.registers(HOLDING_REGISTER if pdu[0] == 3 else INPUT_REGISTER, address, count)
+        if isinstance(data, int):
+            return data
+        return bytes((pdu[0], len(data))) + data
+
+    def registers(self, table: str, address: int, count: int):
+        """The words at address..address+count as bytes, or exception 02."""
+        if not self.tables[table].readable(address, count):
+            return ILLEGAL_DATA_ADDRESS
+        images = self.backend.images
+        if table == INPUT_REGISTER:
+            return images.input_registers[2 * address:2 * (address + count)]
+        data = images.holding[2 * address:2 * (address + count)]
+        patched = None
+        for a in self.backend.live_addresses:
+            if address <= a < address + count:
+                v = self.backend.live_holding(a)
+                if v is not None:
+                    if patched is None:
+                        patched = bytearray(data)
+                    struct.pack_into(">H", patched, 2 * (a - address), v)
+        return data if patched is None else bytes(patched)
+
+    # -- writes ---------------------------------------------------------------------------------------
+    def _write(self, table: str, address: int, words: Sequence[int]) -> int:
+        """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code."""
+        t = self.tables[table]
+        if not t.writable(address, len(words)):
+            return ILLEGAL_DATA_ADDRESS
+        changes = []
+        a, end = address, address + len(words)
+        while a < end:
+            e = t.entry_at[a]
+            if not e.writable:
+                return ILLEGAL_DATA_ADDRESS
+            value = e.si_of_words(list(words[a - address:a - address + e.count]))
+            if value is None:
+                return ILLEGAL_DATA_VALUE
+            changes.append((e, value))
+            a += e.count
+        return self.backend.submit(changes)
+
+    def _write_coil(self, pdu: bytes):
+        if len(pdu) != 5:
+            return ILLEGAL_DATA_VALUE
+        address, value = _AQ.unpack_from(pdu, 1)
+        if value not in (0x0000, 0xFF00):
+            return ILLEGAL_DATA_VALUE
+        return self._write(COIL, address, [1 if value else 0]) or pdu
+
+    def _write_register(self, pdu: bytes):
+        if len(pdu) != 5:
+            return ILLEGAL_DATA_VALUE
+        address, value = _AQ.unpack_from(pdu, 1)
+        return self._write(HOLDING_REGISTER, address, [value]) or pdu
+
+    def _write_coils(self, pdu: bytes):
+        if len(pdu) < 6:
+            return ILLEGAL_DATA_VALUE
+        address, count = _AQ.unpack_from(pdu, 1)
+        nbytes = pdu[5]
+        if not 1 <= count <= MAX_WRITE_BITS or nbytes != (count + 7) // 8 or len(pdu) != 6 + nbytes:
+            return ILLEGAL_DATA_VALUE
+        bits = [(pdu[6 + (i >> 3)] >> (i & 7)) & 1 for i in range(count)]
+        return self._write(COIL, address, bits) or pdu[:5]
+
+    def _write_registers(self, pdu: bytes):
+        if len(pdu) < 6:
+            return ILLEGAL_DATA_VALUE
+        address, count = _AQ.unpack_from(pdu, 1)
+        nbytes = pdu[5]
+        if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(pdu) != 6 + nbytes:
+            return ILLEGAL_DATA_VALUE
+        words = struct.unpack_from(f">{count}H", pdu, 6)
+        return self._write(HOLDING_REGISTER, address, words) or pdu[:5]
+
+    def _mask_write_register(self, pdu: bytes):
+        """6.16: result = (current AND and_mask) OR (or_mask AND NOT and_mask); the response echoes the request."""
+        if len(pdu) != 7:
+            return ILLEGAL_DATA_VALUE
+        address, and_mask, or_mask = struct.unpack_from(">HHH", pdu, 1)
+        current = self.registers(HOLDING_REGISTER, address, 1)
+        if isinstance(current, int) or not self.tables[HOLDING_REGISTER].writable(address, 1):
+            return ILLEGAL_DATA_ADDRESS
+        (value,) = struct.unpack(">H", current)
+        result = (value & and_mask) | (or_mask & ~and_mask & 0xFFFF)
+        return self._write(HOLDING_REGISTER, address, [result]) or pdu
+
+    def _read_write_registers(self, pdu: bytes):
+        if len(pdu) < 10:
+            return ILLEGAL_DATA_VALUE
+        raddr, rcount, waddr, wcount = struct.unpack_from(">HHHH", pdu, 1)
+        nbytes = pdu[9]
+        if (not 1 <= rcount <= MAX_RW_READ or not 1 <= wcount <= MAX_RW_WRITE or nbytes != 2 * wcount
+                or len(pdu) != 10 + nbytes):
+            return ILLEGAL_DATA_VALUE
+        if not self.tables[HOLDING_REGISTER].readable(raddr, rcount):
+            return ILLEGAL_DATA_ADDRESS
+        # The spec's order: the write first, then the read (which sees the write).
+        code = self._write(HOLDING_REGISTER, waddr, struct.unpack_from(f">{wcount}H", pdu, 10))
+        if code:
+            return code
+        data = self.registers(HOLDING_REGISTER, raddr, rcount)
+        return bytes((23, len(data))) + data
+
+    # -- 43/14: read device identification (6.21) -----------------------------------------------------
+    def _encapsulated(self, pdu: bytes):
+        if len(pdu) < 2 or pdu[1] != MEI_DEVICE_ID:
+            return ILLEGAL_FUNCTION  # 43/13 (CANopen) and other MEI types are not supported
+        if len(pdu) != 4:
+            return ILLEGAL_DATA_VALUE
+        code, object_id = pdu[2], pdu[3]
+        if code not in (BASIC, REGULAR, EXTENDED, INDIVIDUAL):
+            return ILLEGAL_DATA_VALUE
+        objects = self.id_objects
+        levels = {_category(k) for k in objects}
+        conformity = 0x80 | max(levels)  # stream and individual access
+        if code == INDIVIDUAL:
+            if object_id not in objects:
+                return ILLEGAL_DATA_ADDRESS
+            value = objects[object_id]
+            return bytes((MEI, MEI_DEVICE_ID, code, conformity, 0x00, 0x00, 1, object_id, len(value))) + value
+        ids = [k for k in sorted(objects) if _category(k) <= code]
+        if object_id not in ids:  # "as if object 0 were pointed out": restart at the beginning
+            object_id = 0
+        ids = [k for k in ids if k >= object_id]
+        body, count, more, next_id = bytearray(), 0, 0x00, 0x00
+        room = MAX_PDU - 7
+        for k in ids:
+            item = bytes((k, len(objects[k]))) + objects[k]
+            if len(item) > room - len(body):
+                more, next_id = 0xFF, k
+                break
+            body += item
+            count += 1
+        return bytes((MEI, MEI_DEVICE_ID, code, conformity, more, next_id, count)) + bytes(body)
+
+    _HANDLERS = {1: _read_bits, 2: _read_bits, 3: _read_registers, 4: _read_registers, 5: _write_coil,
+                 6: _write_register, 15: _write_coils, 16: _write_registers, 22: _mask_write_register,
+                 23: _read_write_registers, 43: _encapsulated}
