@@ -145,6 +145,7 @@ class Station:
     robot_targets: dict[str, Placement]
     controller: ControllerSpec | None
     watchdog: WatchdogSpec | None = None
+    profile: dict | None = None  # the raw `[profile]` table: read and checked by twin.profiles, not the core
 
     @property
     def folder(self) -> Path:
@@ -419,9 +420,10 @@ def load_station(path: str | Path) -> Station:
                                        check=lambda v: None if v in SAFE_STATES else f"must be one of {', '.join(SAFE_STATES)}"),
                                 opened)
         wr.done()
+    profile = top.get("profile", dict, None)  # a device profile's mapping (twin.profiles checks it)
     top.done()
     station = Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller,
-                      watchdog)
+                      watchdog, profile)
     gripper_mechanism(station)  # the gripper's URDF and what the station says about it must agree
     return station
 

@@ -95,7 +95,9 @@ def add_commands(subparsers) -> None:
     p.add_argument("station", help="a station folder or station.toml")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback only)")
     p.add_argument("--port", type=_port, default=5020, help="TCP port (default 5020; 0 = any free port, printed)")
-    p.add_argument("--unit-id", type=_unit, default=1, help="Modbus unit id answered (default 1; 0 and 255 too)")
+    p.add_argument("--unit-id", type=_unit, default=None,
+                   help="Modbus unit id answered (default 1; 0 and 255 too); with --profile: the profile's unit id "
+                        "(default: every unit id but --map-unit-id)")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--realtime", dest="lockstep", action="store_false",
                       help="step paced to the wall clock at the station's step (the default)")
@@ -127,6 +129,7 @@ def add_commands(subparsers) -> None:
     g.add_argument("--tls-ca", metavar="PEM", help="CA certificate(s) client certificates must chain to (required)")
     g.add_argument("--tls-port", type=_port, default=TLS_PORT, help=f"the TLS port (default {TLS_PORT}; 0 = any free)")
     g.add_argument("--tls-only", action="store_true", help="with TLS: do not listen on plain Modbus/TCP (--port)")
+    _add_profile_arguments(p)
     p.set_defaults(func=cmd_serve, lockstep=False)
 
     p = subparsers.add_parser("map", help="print the Modbus register map of a station",
@@ -134,6 +137,19 @@ def add_commands(subparsers) -> None:
     p.add_argument("station", help="a station folder or station.toml")
     p.add_argument("--format", choices=("json", "csv", "md"), default="md", help="output format (default md)")
     p.set_defaults(func=cmd_map)
+
+
+def _add_profile_arguments(p) -> None:
+    from twin.profiles.robotiq import PROFILES
+
+    from .profile import MAP_UNIT_ID
+
+    g = p.add_argument_group("device profiles (see twin/modbus/README.md, Device profiles)")
+    g.add_argument("--profile", choices=PROFILES, default=None,
+                   help="answer as a real gripper: Robotiq's registers at their published addresses, mapped onto the "
+                        "station by its [profile] table")
+    g.add_argument("--map-unit-id", type=_unit, default=MAP_UNIT_ID,
+                   help=f"with --profile: the unit id that keeps the generated map and sim.* (default {MAP_UNIT_ID})")
 
 
 def cmd_map(args) -> int:
@@ -205,14 +221,28 @@ def cmd_serve(args) -> int:
             return tls
         from .register_map import build_register_map
 
+        if args.profile and args.unit_id is not None and args.unit_id == args.map_unit_id:
+            _log(f"error: --unit-id {args.unit_id} is also the --map-unit-id: give them different unit ids", logging.ERROR)
+            return 2
         announce(f"loading station {args.station}")
         twin = open_twin(args.station, on_event=controller_log)
         rmap = build_register_map(twin.signals, twin.station.name)
+        profile = None
+        if args.profile:
+            from twin.core.errors import StationError
+            from twin.profiles.robotiq import open_profile
+
+            try:
+                profile = open_profile(twin, args.profile)
+            except StationError as exc:
+                _log(f"error: --profile {args.profile}: {exc}", logging.ERROR)
+                return 2
         if signals.received is not None:
             raise StopRequested(signals.received)
-        return asyncio.run(serve(twin, rmap, host=args.host, port=args.port, unit_id=args.unit_id,
+        return asyncio.run(serve(twin, rmap, host=args.host, port=args.port,
+                                 unit_id=1 if args.unit_id is None else args.unit_id,
                                  lockstep=args.lockstep, speed=args.speed, frame_timeout=args.frame_timeout, stop=stop,
-                                 options=args, tls=tls))
+                                 options=args, tls=tls, profile=profile))
     except BaseException:
         if signals.received is None:
             raise
@@ -276,9 +306,11 @@ def device_identity(twin, rmap):
 
 async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1, lockstep: bool = False,
                 speed: float = 1.0, frame_timeout: float = 1.0, stop: asyncio.Event | None = None,
-                options=None, tls=None) -> int:
+                options=None, tls=None, profile=None) -> int:
     """Serve `twin` with `rmap` until `stop` is set (or SIGINT/SIGTERM). Returns the exit code.
-    `options`: the parsed `twin serve` flags (limits, access, watchdog); `tls`: an ssl.SSLContext."""
+    `options`: the parsed `twin serve` flags (limits, access, watchdog); `tls`: an ssl.SSLContext.
+    `profile`: a device profile's gripper (`twin.profiles.robotiq.open_profile`): it answers on `options.unit_id`
+    if given, else on every unit id but `options.map_unit_id`, which keeps `rmap` (see `twin.modbus.profile`)."""
     from twin.pacing import LockstepRunner, RealtimeRunner
 
     from .bridge import TwinBridge
@@ -317,6 +349,12 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
                           idle_timeout=get("idle_timeout", 0.0) or None, allow=get("allow", None),
                           read_only=get("read_only", False), gaps_zero=get("gaps", "error") == "zero",
                           identity=device_identity(twin, rmap), on_request=on_request)
+    if profile is not None:
+        from .profile import MAP_UNIT_ID, serve_profile
+
+        profile_unit = get("unit_id", None)
+        unit_id = get("map_unit_id", MAP_UNIT_ID)
+        serve_profile(server, profile, bridge, unit_id=profile_unit, map_unit_id=unit_id)
     listening = []
     try:
         if not get("tls_only", False):
@@ -336,6 +374,9 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
     if watchdog is not None and watchdog.timeout:
         notes.append(f"watchdog {watchdog.timeout:g} s ({watchdog.safe_state})")
     announce(f"station {twin.station.name!r}: " + ", ".join(notes))
+    if profile is not None:
+        where = f"unit {profile_unit}" if profile_unit is not None else f"every unit id but {unit_id}"
+        announce(f"profile {profile.kind} on {where}")
     for what, bound_host, bound_port in listening:
         announce(f"listening on {bound_host}:{bound_port}{what}")
     task = asyncio.ensure_future(runner.run())

@@ -130,6 +130,7 @@ class ModbusServer:
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
         self.units = {unit_id, 0, 255}
         self.pdus = PduHandler(rmap, backend, read_only=read_only, gaps_zero=gaps_zero, identity=identity)
+        self.route: Callable[[int], PduHandler | None] | None = None  # other unit ids: another device (a profile)
         self.frame_timeout = frame_timeout
         self.requests_per_step, self.step_period, self.serve_share = requests_per_step, step_period, serve_share
         self.max_connections, self.idle_timeout = max_connections, idle_timeout
@@ -202,6 +203,9 @@ class ModbusServer:
     def handle(self, unit: int, pdu: bytes) -> bytes:
         """One request PDU -> its response PDU."""
         if unit not in self.units:
+            other = self.route(unit) if self.route is not None else None
+            if other is not None:
+                return other.handle(pdu)
             self.pdus.requests += 1
             return bytes((pdu[0] | 0x80, GATEWAY_TARGET_FAILED))
         return self.pdus.handle(pdu)
