@@ -35,7 +35,10 @@ Behaviour (the manuals' wording in quotes):
 - Object detection per axis (2F gOBJ, 3F gDTA/gDTB/gDTC/gDTS): 0 moving, 1 stopped by contact while
   opening, 2 stopped by contact while closing, 3 at the requested position; 0 while gGTO is 0. An axis
   that stands still short of its request for `STALL_TIME` has stopped on something (Robotiq detects
-  objects the same way, from the motor, not from a contact sensor). When the twin publishes the finger's
+  objects the same way, from the motor, not from a contact sensor); "still" means it moved less than
+  `STALL_SHARE` of what its requested speed covers in that time. The detection holds ("the axis will
+  stop") until a new request, or until the axis moves on by twice that (the object was lost: moving
+  again). When the twin publishes the finger's
   own `NAME.status` (same meaning), that is used instead. 3F gSTA: 0 while any finger moves, 3 all at
   their request, 2 all stopped short, 1 some stopped short.
 - 3F rMOD (basic, pinch, wide, scissor): a change while activated is a mode change, gIMC 2 for
@@ -62,7 +65,9 @@ from .mapping import AxisMapping, Defaults, ProfileMapping, read_mapping
 
 RESET, ACTIVATING, MODE_CHANGE, READY, RELEASING, RELEASED = "reset", "activating", "mode change", "ready", \
     "releasing", "released"
-STALL_TIME = 0.05  # s an axis stands still short of its request before it counts as stopped by an object
+STALL_TIME = 0.06  # s an axis stands still short of its request before it counts as stopped by an object
+STALL_SHARE = 0.25  # "stands still": it moved less than this share of what its speed covers in STALL_TIME ...
+STALL_FLOOR = {"m": 0.00005, "rad": 0.0005}  # ... and at least this (servo jitter against a part)
 
 NO_FAULT, ACTIVATION_PENDING, MODE_CHANGE_PENDING, NOT_ACTIVATED = 0x00, 0x05, 0x06, 0x07
 RELEASE_IN_PROGRESS, RELEASE_COMPLETED = 0x0B, 0x0F
@@ -85,6 +90,8 @@ class AxisState:
     request: tuple[int, int, int] | None = None  # (position, speed, force) being driven to; None: holding
     closing: bool = True  # the direction of the last request
     stalled: int = 0  # steps standing still short of the request
+    anchor: float | None = None  # where the axis was when it began to stand still
+    still: float = 0.0  # how far it may move and still stand still (from its speed)
     status: int = 0  # 0 moving, 1 stopped opening, 2 stopped closing, 3 at request
     position: int = 0
     current: int = 0
@@ -236,10 +243,13 @@ class RobotiqGripper:
         twin.write(m.input, _clamp_to(twin, m.input, target))
         actual = twin.read(f"{m.input}.actual")
         ax.closing = (target - actual) * (m.closed - m.open) > 0
+        ax.anchor, ax.status = actual, 0
+        ax.still = max(STALL_FLOOR.get(twin.spec(m.input).unit, STALL_FLOOR["m"]),
+                       STALL_SHARE * m.velocity_of(speed) * self._stall_steps * self.dt)
 
     def _hold(self, twin, ax: AxisState) -> None:
         ax.request = None
-        ax.stalled = 0
+        ax.stalled, ax.anchor = 0, None
         if ax.mapping is not None:
             inp = ax.mapping.input
             twin.write(inp, _clamp_to(twin, inp, twin.read(f"{inp}.actual")))
@@ -276,12 +286,20 @@ class RobotiqGripper:
             ax.status = int(twin.read(finger_status))
             return
         if twin.read(f"{inp}.in_position"):
-            ax.status, ax.stalled = 3, 0
-        elif twin.read(f"{inp}.moving"):
-            ax.status, ax.stalled = 0, 0
-        else:
+            ax.status, ax.stalled, ax.anchor = 3, 0, actual
+            return
+        if ax.anchor is None:
+            ax.anchor = actual
+        moved = abs(actual - ax.anchor)
+        if ax.status in (1, 2) and ax.request is not None:  # detected: held until it moves on (object lost)
+            if moved > 2 * ax.still:
+                ax.status, ax.stalled, ax.anchor = 0, 0, actual
+            return
+        if moved <= ax.still:
             ax.stalled += 1
-            ax.status = (2 if ax.closing else 1) if ax.stalled >= self._stall_steps else 0
+        else:
+            ax.stalled, ax.anchor = 0, actual
+        ax.status = (2 if ax.closing else 1) if ax.stalled >= self._stall_steps else 0
 
     def _drive_force(self, twin, ax: AxisState) -> float:
         effort = f"{ax.mapping.input}.effort"
