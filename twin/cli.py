@@ -84,6 +84,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("station", nargs="?", default=str(Path(__file__).resolve().parent.parent / "stations" / "ring_rig"))
     p.add_argument("--cycles", type=int, default=1, help="how many full cycles to run")
     p.set_defaults(func=cmd_demo)
+    from .campaign.cli import add_command as add_campaign
+
+    add_campaign(sub)
     try:
         from .modbus.cli import add_commands
     except ImportError:

@@ -54,6 +54,7 @@ class Robot:
         self._end_tcp: Pose | None = None
         self._settled = True
         self._hold = self.q
+        self._paused: np.ndarray | None = None  # while paused: where the arm holds
 
     # -- state --------------------------------------------------------------------------------------
     @property
@@ -122,6 +123,15 @@ class Robot:
         """Stop following the trajectory and hold where the arm is now."""
         self._traj, self._settled, self._hold = None, True, self.q
 
+    def pause(self, paused: bool = True) -> None:
+        """A robot stop (protective stop, feed hold): the arm holds where it is and a motion under way waits,
+        its time frozen, busy all along; `pause(False)` lets it go on along its path."""
+        self._paused = self.q if paused else None
+
+    @property
+    def paused(self) -> bool:
+        return self._paused is not None
+
     def busy(self, t: float) -> bool:
         """True while a motion runs or has not yet settled at its end point.
 
@@ -154,6 +164,11 @@ class Robot:
     def update(self, t: float) -> None:
         """Command the arm for the step from t to t + dt (call once per step, before physics steps)."""
         traj = self._traj
+        if self._paused is not None:
+            if traj is not None and self._t0 is not None:
+                self._t0 += self.dt  # the motion's clock stands still
+            self._command(self._paused, np.zeros(len(self.joints)))
+            return
         if traj is None:
             self._command(self._hold, np.zeros(len(self.joints)))
             return
