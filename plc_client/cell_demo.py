@@ -111,7 +111,7 @@ class CellDemo:
 
     def __init__(self, station: str | Path = DEFAULT_STATION, cycles: int = 1, *, realtime: bool = False,
                  speed: float = 1.0, remove_ring_at: int | None = None, scan_cycle: float = 0.010,
-                 out: Callable[[str], None] | None = None):
+                 out: Callable[[str], None] | None = None, record: str | Path | None = None):
         if cycles < 1:
             raise ValueError("at least one cycle")
         if not (speed > 0 and scan_cycle > 0):
@@ -125,6 +125,7 @@ class CellDemo:
         self.scans = 0  # PLC scans of the last run
         self.requests = 0  # Modbus requests the PLC sent in the last run
         self.grip = ring_rig.cell_sequence()  # the gripper PLC
+        self.record = record  # twin serve --record FILE: every signal and body pose at every step
 
     def say(self, who: str, text: str) -> None:
         self.out(f"[t={self.now:8.3f} s] {who}: {text}")
@@ -149,7 +150,9 @@ class CellDemo:
         logic = Combined(self.grip, operator(self.cycles, self.remove_ring_at))
         mode = "lockstep: the PLC steps the twin" if not self.realtime else f"real time x{self.speed:g}"
         self.out(f"demo: {self.station.name}, {self.cycles} cycle(s), {mode}, PLC scan {self.scan_cycle * 1000:g} ms")
-        with twin_server(self.station, lockstep=not self.realtime, speed=None if not self.realtime else self.speed) as server:
+        extra = ["--record", str(self.record)] if self.record is not None else []
+        with twin_server(self.station, lockstep=not self.realtime, speed=None if not self.realtime else self.speed,
+                         extra_args=extra) as server:
             missing = [n for n in dict.fromkeys((*logic.inputs, *logic.outputs, *WATCH)) if n not in server.map]
             if missing:
                 raise DemoError(f"{self.station}: not a cell the demo can run: it has no {', '.join(missing)} "
@@ -314,7 +317,7 @@ def main(args) -> int:
         raise DemoError(f"--remove-ring {args.remove_ring} is after the last cycle (--cycles {args.cycles}): "
                         "the ring would never be taken away")
     demo = CellDemo(args.station, args.cycles, realtime=args.realtime, speed=args.speed,
-                    remove_ring_at=args.remove_ring, scan_cycle=args.scan)
+                    remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=args.record)
     return demo.run().exit_status
 
 
@@ -342,6 +345,8 @@ def add_command(sub) -> None:
                    help="take the ring out of the cell when this cycle starts (1..--cycles): a missed grip, "
                         "detected and reported; exit status 0 only if it is")
     p.add_argument("--scan", type=positive_float, metavar="S", default=0.010, help="PLC scan cycle, s (default 0.010)")
+    p.add_argument("--record", metavar="FILE", default=None,
+                   help="record every signal and body pose at every step (twin serve --record): .parquet or .csv")
     p.set_defaults(func=main)
 
 

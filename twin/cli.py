@@ -93,6 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
         pass
     else:
         add_commands(sub)
+    from .view.cli import add_commands as add_view_commands  # view, plot, snapshot
+
+    add_view_commands(sub)
     return parser
 
 

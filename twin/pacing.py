@@ -42,6 +42,8 @@ class RealtimeRunner:
         self.resyncs = 0
         self.max_late = 0.0  # s, the worst lateness seen
         self._stop = False
+        self.paused = False  # pause(): no steps until resume(); single_step() runs one meanwhile
+        self._resumed: asyncio.Event | None = None
 
     @property
     def remaining(self) -> int:
@@ -49,17 +51,41 @@ class RealtimeRunner:
 
     def stop(self) -> None:
         self._stop = True
+        self.resume()
+
+    def pause(self) -> None:
+        """Stop stepping (from the event loop's thread) until `resume()`; paused time is not late time."""
+        self.paused = True
+
+    def resume(self) -> None:
+        self.paused = False
+        if self._resumed is not None:
+            self._resumed.set()
+
+    def single_step(self) -> None:
+        """While paused: run one step now."""
+        if self.paused and not self._stop:
+            if self.step():
+                self.steps += 1
 
     async def run(self) -> None:
         clock, period = self.clock, self.period
+        self._resumed = asyncio.Event()
         t0 = clock()
         k = 0  # steps run since t0
         while not self._stop:
+            if self.paused:
+                self._resumed.clear()
+                await self._resumed.wait()
+                t0, k = clock(), 0  # the schedule starts again from now
+                continue
             delay = t0 + k * period - clock()
             # Sleep until the step's start; never run two steps without letting the server answer.
             await asyncio.sleep(delay if delay > 0 else 0)
             if self._stop:
                 break
+            if self.paused:
+                continue
             if not self.step():
                 return
             k += 1

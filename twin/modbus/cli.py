@@ -130,6 +130,9 @@ def add_commands(subparsers) -> None:
     g.add_argument("--tls-port", type=_port, default=TLS_PORT, help=f"the TLS port (default {TLS_PORT}; 0 = any free)")
     g.add_argument("--tls-only", action="store_true", help="with TLS: do not listen on plain Modbus/TCP (--port)")
     _add_profile_arguments(p)
+    from twin.view.live import add_serve_options  # --view [PORT], --record FILE (twin.view, twin.recording)
+
+    add_serve_options(p)
     p.set_defaults(func=cmd_serve, lockstep=False)
 
     p = subparsers.add_parser("map", help="print the Modbus register map of a station",
@@ -379,6 +382,10 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
         announce(f"profile {profile.kind} on {where}")
     for what, bound_host, bound_port in listening:
         announce(f"listening on {bound_host}:{bound_port}{what}")
+    from twin.view.live import serve_front_ends  # --view, --record: the page and the recorder
+
+    start_front_ends = serve_front_ends(opt)
+    stop_front_ends = start_front_ends(twin, bridge, runner, rmap) if start_front_ends is not None else None
     task = asyncio.ensure_future(runner.run())
     stopper = asyncio.ensure_future(stop.wait())
     await asyncio.wait({task, stopper}, return_when=asyncio.FIRST_COMPLETED)
@@ -388,6 +395,8 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
         await stop.wait()  # faulted: keep serving the last state until stopped
     runner.stop()
     await server.close()
+    if stop_front_ends is not None:
+        stop_front_ends()
     for t in (task, stopper):
         if not t.done():
             t.cancel()
