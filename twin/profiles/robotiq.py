@@ -285,7 +285,7 @@ class RobotiqGripper:
         if ax.request is not None and finger_status in self._names:
             ax.status = int(twin.read(finger_status))
             return
-        if twin.read(f"{inp}.in_position"):
+        if twin.read(f"{inp}.in_position") and not twin.read(f"{inp}.moving"):  # arrived, not passing by
             ax.status, ax.stalled, ax.anchor = 3, 0, actual
             return
         if ax.anchor is None:
