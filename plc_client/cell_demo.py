@@ -316,9 +316,21 @@ def main(args) -> int:
     if args.remove_ring is not None and args.remove_ring > args.cycles:
         raise DemoError(f"--remove-ring {args.remove_ring} is after the last cycle (--cycles {args.cycles}): "
                         "the ring would never be taken away")
+    from .demo_report import recording_for, report
+
+    lines: list[str] = []
+    record = recording_for(args.record, args.report)
+
+    def out(line: str) -> None:
+        lines.append(line)
+        print(line, flush=True)
+
     demo = CellDemo(args.station, args.cycles, realtime=args.realtime, speed=args.speed,
-                    remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=args.record)
-    return demo.run().exit_status
+                    remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=record, out=out)
+    summary = demo.run()
+    if args.report is not None:
+        report(record, args.report, threshold=demo.grip.threshold, narration=lines)
+    return summary.exit_status
 
 
 EXIT_STATUS_HELP = """exit status:
@@ -347,6 +359,11 @@ def add_command(sub) -> None:
     p.add_argument("--scan", type=positive_float, metavar="S", default=0.010, help="PLC scan cycle, s (default 0.010)")
     p.add_argument("--record", metavar="FILE", default=None,
                    help="record every signal and body pose at every step (twin serve --record): .parquet or .csv")
+    rep = p.add_mutually_exclusive_group()
+    rep.add_argument("--report", metavar="DIR", default="demo-report",
+                     help="write the run's report there: index.html, the signal plot, the cell at each grip and release "
+                          "(default demo-report)")
+    rep.add_argument("--no-report", dest="report", action="store_const", const=None, help="no report")
     p.set_defaults(func=main)
 
 

@@ -84,7 +84,7 @@ def test_a_missed_grip_raises_the_fault_and_the_robot_does_not_carry_on():
 
 
 def test_the_demo_command_prints_its_steps_and_a_summary():
-    out = subprocess.run([sys.executable, "-m", "plc_client", "demo", "--cycles", "1"], cwd=ROOT,
+    out = subprocess.run([sys.executable, "-m", "plc_client", "demo", "--cycles", "1", "--no-report"], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.splitlines()
