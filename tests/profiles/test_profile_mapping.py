@@ -68,3 +68,23 @@ def test_serve_refuses_a_profile_the_station_does_not_map():
                        capture_output=True, text=True, timeout=60, cwd=ROOT)
     assert r.returncode == 2
     assert "profile.A: is required" in r.stderr
+
+
+def test_a_gripper_that_is_not_always_active_moves_once_activated(tmp_path):
+    """rACT drives the twin's `Active`: without it the jaws stand (fault 0x07 for a go-to), activated they close."""
+    folder = _station(tmp_path, '[profile]\njaw = { input = "jaw_left", open = 0.025, closed = 0.0 }')
+    toml = folder / "station.toml"
+    toml.write_text(toml.read_text().replace("always_active = true", "always_active = false"))
+    with Twin.from_station(folder) as twin:
+        g = open_profile(twin, "robotiq-2f")
+        g.write_output_word(0, 0x0800)  # go-to without activation
+        g.write_output_word(1, 0x00FF)
+        g.write_output_word(2, 0xFFFF)
+        twin.step(50)
+        assert g.input[2] == 0x07 and twin.read("jaw_left.actual") == pytest.approx(0.025, abs=1e-4)
+        assert twin.read("Active") is False
+        g.write_output_word(0, 0x0900)
+        twin.step(round(1.5 / twin.dt) + 100)
+        assert twin.read("Active") is True
+        assert g.input[0] == 0xB9  # activated, go-to, stopped on the cube while closing
+        assert twin.read("jaw_left.actual") == pytest.approx(0.010, abs=0.001)  # the 20 mm cube's faces

@@ -38,8 +38,8 @@ Behaviour (the manuals' wording in quotes):
   objects the same way, from the motor, not from a contact sensor); "still" means it moved less than
   `STALL_SHARE` of what its requested speed covers in that time. The detection holds ("the axis will
   stop") until a new request, or until the axis moves on by twice that (the object was lost: moving
-  again). When the twin publishes the finger's
-  own `NAME.status` (same meaning), that is used instead. 3F gSTA: 0 while any finger moves, 3 all at
+  again). When the twin publishes the finger's own `NAME.status` (same meaning, from its contacts), a
+  contact stop there counts at once; the direction (opening or closing) is always the profile's own. 3F gSTA: 0 while any finger moves, 3 all at
   their request, 2 all stopped short, 1 some stopped short.
 - 3F rMOD (basic, pinch, wide, scissor): a change while activated is a mode change, gIMC 2 for
   `mode_change_time`; gMOD echoes rMOD. In scissor mode rPRA drives the scissor axis and the fingers
@@ -117,6 +117,7 @@ class RobotiqGripper:
         self.mode = 0
         self._gto = False
         self._names = {s.name for s in twin.signals}
+        self._enabled: bool | None = None  # what was last written to the twin's `Active`
         servos = getattr(getattr(twin, "gripper", None), "finger_servos", {}) or {}
         required, optional = AXES[kind]
         self.axes: dict[str, AxisState] = {}
@@ -152,6 +153,13 @@ class RobotiqGripper:
 
     def before_step(self, twin) -> None:
         """Act on the robot output as it stands: the state machine, then the axes' commands."""
+        self._step(twin)
+        enabled = self.state != RESET  # a reset gripper's drives are off: the twin's `Active` follows
+        if enabled != self._enabled and "Active" in self._names:
+            twin.write("Active", enabled)
+            self._enabled = enabled
+
+    def _step(self, twin) -> None:
         out = self.output
         act, gto, atr = out[0] & 1, (out[0] >> 3) & 1, (out[0] >> 4) & 1
         mode = (out[0] >> 1) & 3 if self.kind == "robotiq-3f" else 0
@@ -282,9 +290,6 @@ class RobotiqGripper:
         ax.position = m.position_of(actual)
         ax.current = m.current_of(self._drive_force(twin, ax))
         finger_status = f"{m.finger}.status" if m.finger else None
-        if ax.request is not None and finger_status in self._names:
-            ax.status = int(twin.read(finger_status))
-            return
         if twin.read(f"{inp}.in_position") and not twin.read(f"{inp}.moving"):  # arrived, not passing by
             ax.status, ax.stalled, ax.anchor = 3, 0, actual
             return
@@ -299,6 +304,11 @@ class RobotiqGripper:
             ax.stalled += 1
         else:
             ax.stalled, ax.anchor = 0, actual
+        # the core's own per-finger status (contact-aware) detects a stop at once; the direction is the profile's
+        touched = (ax.request is not None and finger_status in self._names
+                   and int(twin.read(finger_status)) in (1, 2))
+        if touched:
+            ax.stalled, ax.anchor = max(ax.stalled, self._stall_steps), actual
         ax.status = (2 if ax.closing else 1) if ax.stalled >= self._stall_steps else 0
 
     def _drive_force(self, twin, ax: AxisState) -> float:
