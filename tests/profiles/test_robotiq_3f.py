@@ -141,3 +141,25 @@ def test_driver_style_client_grips_the_ring(server_3f):
         assert all(100 <= cur <= 160 for cur in (s[5], s[8], s[11]))  # half force: about half the current
     finally:
         c.close()
+
+
+def test_mode_change_and_automatic_release(g):
+    g.write(0x0000, [0x0100, 0, 0])
+    g.until(lambda s: s[0] == 0x31, address=0, count=1)
+    g.write(0x0000, [0x0B00, 0x0040, 0xFFFF])  # pinch mode (rMOD 1) and go to 64 at once
+    g.advance(1)
+    s = g.status(0, 2)
+    assert s[0] == 0x23 and s[2] == 0x06  # gMOD 1, gIMC 2 "mode change in progress"; "action delayed, mode change"
+    steps, s = g.until(lambda s: s[0] & 0x30 == 0x30, address=0, count=2)
+    assert 0.5 <= steps * 0.012 <= 2.0 and s[2] == 0x00  # completed: the fault clears, the go-to runs
+    _, s = g.until(lambda s: s[0] >> 6 == 3, address=0, count=8)
+    assert s[0] == 0xFB and all(abs(p - 64) <= 1 for p in (s[4], s[7], s[10]))  # gMOD 1, at 64
+    g.write(0x0000, [0x1B00])  # rATR: automatic release
+    g.advance(1)
+    s = g.status(0, 2)
+    assert s[0] & 0x38 == 0 and s[2] == 0x0B  # gIMC 0 (release state), gGTO 0, "automatic release in progress"
+    _, s = g.until(lambda s: s[2] == 0x0F, address=0, count=8)  # "completed, reset and activation is required"
+    assert s[4] == s[7] == s[10] == 0  # released: open
+    g.write(0x0000, [0x0000])  # rACT 0 clears it
+    g.advance(1)
+    assert g.status(0, 2) == b"\x00\x00\x00\x00"
