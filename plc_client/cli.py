@@ -62,9 +62,13 @@ def _globals(parser: argparse.ArgumentParser, suppress: bool) -> None:
     d = (lambda v: argparse.SUPPRESS) if suppress else (lambda v: v)
     g = parser.add_argument_group("connection and map")
     g.add_argument("--host", default=d("127.0.0.1"), help="the twin server's host (default 127.0.0.1)")
-    g.add_argument("--port", type=int, default=d(5020), help="its Modbus/TCP port (default 5020)")
+    g.add_argument("--port", type=int, default=d(None), help="its Modbus/TCP port (default 5020; with TLS 802)")
     g.add_argument("--unit-id", type=int, default=d(1), help="the Modbus unit id (default 1)")
     g.add_argument("--timeout", type=float, default=d(3.0), help="s to wait for an answer (default 3)")
+    g.add_argument("--tls-cert", metavar="PEM", default=d(None),
+                   help="Modbus/TCP Security: connect over TLS with this client certificate (with --tls-key, --tls-ca)")
+    g.add_argument("--tls-key", metavar="PEM", default=d(None), help="the client certificate's private key")
+    g.add_argument("--tls-ca", metavar="PEM", default=d(None), help="the CA the server's certificate must chain to")
     m = g.add_mutually_exclusive_group()
     m.add_argument("--map", metavar="FILE.json", default=d(None), help="the register map, from `twin map STATION --format json`")
     m.add_argument("--station", metavar="DIR", default=d(None), help="build the register map from this station")
@@ -123,8 +127,23 @@ def load_map(args) -> RegisterMap:
     raise UsageError("no register map: give --map FILE.json (from `twin map STATION --format json`) or --station DIR")
 
 
+def tls_files(args):
+    """TlsFiles from --tls-cert/--tls-key/--tls-ca (all three, or none)."""
+    from .client import TlsFiles
+
+    given = [getattr(args, k, None) for k in ("tls_cert", "tls_key", "tls_ca")]
+    if not any(given):
+        return None
+    if not all(given):
+        raise UsageError("Modbus/TCP Security needs all of --tls-cert, --tls-key and --tls-ca")
+    return TlsFiles(*given)
+
+
 def connect(args, rmap: RegisterMap) -> TwinClient:
-    return TwinClient.connect(args.host, args.port, args.unit_id, map=rmap, timeout=args.timeout)
+    tls = tls_files(args)
+    if args.port is None:
+        args.port = 802 if tls is not None else 5020
+    return TwinClient.connect(args.host, args.port, args.unit_id, map=rmap, timeout=args.timeout, tls=tls)
 
 
 def cmd_read(args) -> int:

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import json
 import math
+import ssl
+import threading
 import time
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -32,13 +34,35 @@ from .scan import LocalSignals
 from twin.native_output import quiet_native_output
 
 from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
-                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, TABLES, TYPE_LIMITS, Entry, map_crc)
+                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, STEP, TABLES, TYPE_LIMITS, WATCHDOG_MS, Entry,
+                                      map_crc)
 
 Signal = Entry  # one entry of the register map, as the server builds it (twin.modbus.register_map)
 WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
 MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
 MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
 FLOAT32_MAX = 3.4028234663852886e38
+
+
+@dataclass(frozen=True)
+class TlsFiles:
+    """Modbus/TCP Security from the client's side: its certificate and key, and the CA the server's
+    certificate must chain to (checked; its host name is not: pymodbus's TLS client does not pass one)."""
+
+    cert: str | Path
+    key: str | Path
+    ca: str | Path
+
+    def context(self) -> ssl.SSLContext:
+        ctx = ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT)
+        ctx.minimum_version = ssl.TLSVersion.TLSv1_2
+        ctx.check_hostname = False  # the chain to the CA is still required (verify_mode stays CERT_REQUIRED)
+        try:
+            ctx.load_verify_locations(str(self.ca))
+            ctx.load_cert_chain(str(self.cert), str(self.key))
+        except (OSError, ssl.SSLError) as exc:
+            raise PlcClientError(f"TLS: cannot use certificate {self.cert} / key {self.key} / CA {self.ca}: {exc}") from None
+        return ctx
 
 
 def range_text(s: Signal) -> str:
@@ -252,15 +276,28 @@ class TwinClient:
     """A connection to a twin server, signals by name (see the module's docstring)."""
 
     def __init__(self, register_map: RegisterMap, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1,
-                 timeout: float = 3.0):
+                 timeout: float = 3.0, *, tls: TlsFiles | None = None, heartbeat: float | str | None = "auto"):
         self.map, self.host, self.port, self.unit_id, self.timeout = register_map, host, int(port), int(unit_id), timeout
+        self.tls = tls
+        self.heartbeat = heartbeat  # s between requests at least; "auto": a third of the server's watchdog time
         self._client = None
+        self._lock = threading.RLock()  # the heartbeat thread and the caller share the connection
+        self._last_request = 0.0
+        self._beat: threading.Thread | None = None
+        self._closing = threading.Event()
         self.requests = 0  # requests sent, for tests and diagnostics
+        self.heartbeats = 0
 
     @classmethod
-    def connect(cls, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1, *, map: str | Path | RegisterMap | None = None,
-                station: str | Path | None = None, timeout: float = 3.0) -> "TwinClient":
-        """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`."""
+    def connect(cls, host: str = "127.0.0.1", port: int | None = None, unit_id: int = 1, *,
+                map: str | Path | RegisterMap | None = None, station: str | Path | None = None, timeout: float = 3.0,
+                tls: TlsFiles | None = None, heartbeat: float | str | None = "auto") -> "TwinClient":
+        """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`.
+        `tls`: Modbus/TCP Security with these certificate files (port default 802, else 5020).
+        `heartbeat`: see `TwinClient` (a request at least that often, so the server's watchdog sees a quiet
+        but healthy PLC)."""
+        if port is None:
+            port = 802 if tls is not None else 5020
         if isinstance(map, RegisterMap):
             rmap = map
         elif map is not None:
@@ -269,14 +306,18 @@ class TwinClient:
             rmap = RegisterMap.from_station(station)
         else:
             raise MapError("no register map: give map=FILE.json (from `twin map STATION --format json`) or station=DIR")
-        client = cls(rmap, host, port, unit_id, timeout)
+        client = cls(rmap, host, port, unit_id, timeout, tls=tls, heartbeat=heartbeat)
         client.open()
         return client
 
     def open(self) -> None:
-        from pymodbus.client import ModbusTcpClient
+        from pymodbus.client import ModbusTcpClient, ModbusTlsClient
 
-        self._client = ModbusTcpClient(self.host, port=self.port, timeout=self.timeout, retries=0)
+        if self.tls is not None:
+            self._client = ModbusTlsClient(self.host, port=self.port, sslctx=self.tls.context(), timeout=self.timeout,
+                                           retries=0)
+        else:
+            self._client = ModbusTcpClient(self.host, port=self.port, timeout=self.timeout, retries=0)
         try:
             ok = self._client.connect()
         except Exception as exc:  # pymodbus wraps socket errors differently across versions
@@ -289,6 +330,41 @@ class TwinClient:
         except BaseException:
             self.close()
             raise
+        self._start_heartbeat()
+
+    def _start_heartbeat(self) -> None:
+        """A background request (a read of sim.step) whenever the connection has been quiet for the
+        heartbeat interval. "auto": a third of the server's `comm.watchdog_ms` (none when it is 0)."""
+        interval = self.heartbeat
+        if interval == "auto":
+            interval = None
+            if WATCHDOG_MS in self.map:
+                try:
+                    ms = self.get(WATCHDOG_MS)
+                except PlcClientError:
+                    ms = 0
+                interval = ms / 3000.0 if ms else None
+        if not interval:
+            return
+        self.heartbeat_interval = float(interval)
+        self._closing.clear()
+        self._beat = threading.Thread(target=self._heartbeat, args=(self.heartbeat_interval,), daemon=True,
+                                      name="plc-heartbeat")
+        self._beat.start()
+
+    def _heartbeat(self, interval: float) -> None:
+        probe = self.map[STEP] if STEP in self.map else next(iter(self.map))
+        while not self._closing.wait(max(0.001, self._last_request + interval - time.monotonic())):
+            if time.monotonic() - self._last_request < interval:
+                continue
+            with self._lock:
+                if self._client is None:
+                    return
+                try:
+                    self.read_signals([probe])
+                    self.heartbeats += 1
+                except PlcClientError:
+                    return  # the caller sees the broken connection at its next request
 
     def _check_map(self) -> None:
         """A map with `sim.map_crc`: the server must publish the same CRC, else it serves another map (a
@@ -313,9 +389,11 @@ class TwinClient:
                            "or `twin map STATION --format json`")
 
     def close(self) -> None:
-        if self._client is not None:
-            self._client.close()
-            self._client = None
+        self._closing.set()
+        with self._lock:
+            if self._client is not None:
+                self._client.close()
+                self._client = None
 
     def __enter__(self) -> "TwinClient":
         if self._client is None:
@@ -333,7 +411,9 @@ class TwinClient:
 
         self.requests += 1
         try:
-            response = getattr(self._client, method)(address, *args, device_id=self.unit_id, **kw)
+            with self._lock:
+                self._last_request = time.monotonic()
+                response = getattr(self._client, method)(address, *args, device_id=self.unit_id, **kw)
         except ModbusException as exc:
             raise ConnectionFailedError(self.host, self.port, str(exc).strip() or type(exc).__name__) from None
         except OSError as exc:

@@ -21,21 +21,33 @@ SMART_GRIPPER = ROOT / "stations" / "smart_gripper"
 class ServerProcess:
     """`twin serve STATION --port 0 ...` as a subprocess; its stderr is collected line by line."""
 
-    def __init__(self, station: Path, *args: str):
-        self.cmd = [sys.executable, "-m", "twin", "serve", str(station), "--port", "0", *args]
+    def __init__(self, station: Path, *args: str, drain: bool = True, port: str = "0"):
+        """`drain=False`: stderr is read up to the `listening on` line(s), then nobody reads the pipe."""
+        self.cmd = [sys.executable, "-m", "twin", "serve", str(station), "--port", port, *args]
         self.proc = subprocess.Popen(self.cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                      cwd=ROOT, env={**os.environ, "PYTHONUNBUFFERED": "1"})
         self.lines: list[str] = []
         self._seen = threading.Condition()
+        self.drain = drain
         threading.Thread(target=self._drain, daemon=True).start()
-        m = self.wait_for(r"listening on ([\d.]+):(\d+)", timeout=30)
-        self.host, self.port = m.group(1), int(m.group(2))
+        self.tls_port = None
+        if "--tls-cert" in self.cmd:
+            self.tls_port = int(self.wait_for(r"listening on [\d.]+:(\d+) \(Modbus/TCP Security", timeout=30).group(1))
+        self.host, self.port = "127.0.0.1", self.tls_port
+        if "--tls-only" not in self.cmd:
+            m = self.wait_for(r"listening on ([\d.]+):(\d+)$", timeout=30)
+            self.host, self.port = m.group(1), int(m.group(2))
 
     def _drain(self) -> None:
+        listening = 0
+        want = 2 if "--tls-cert" in self.cmd and "--tls-only" not in self.cmd else 1
         for line in self.proc.stderr:
             with self._seen:
                 self.lines.append(line.rstrip("\n"))
                 self._seen.notify_all()
+            listening += "listening on" in line
+            if not self.drain and listening >= want:
+                return  # from now on nobody reads the pipe
         with self._seen:
             self._seen.notify_all()
 

@@ -2,6 +2,7 @@
 simulation runner and the other clients (a real `twin serve` in real time, over loopback)."""
 from __future__ import annotations
 
+import os
 import statistics
 import struct
 import subprocess
@@ -49,7 +50,7 @@ def counters(raw: Raw) -> tuple[int, int]:
 def test_a_flooding_client_leaves_the_simulation_and_the_other_clients_their_turn():
     with ServerProcess(RING_BENCH) as server, Raw(server.port) as other:
         flooder = subprocess.Popen([sys.executable, __file__, str(server.port), "4.0"], stdout=subprocess.PIPE,
-                                   text=True)
+                                   text=True, preexec_fn=lambda: os.nice(10))
         try:
             time.sleep(0.5)  # the flood is on
             step0, late0 = counters(other)
@@ -76,9 +77,54 @@ def test_a_flooding_client_leaves_the_simulation_and_the_other_clients_their_tur
               f"p99 {p99 * 1e3:.1f} ms; {steps} steps in {wall:.2f} s ({late} late)")
     assert answered > FLOOD, report  # the flood itself was served
     # Unfair (a whole socket read answered in one callback): p50 ~130 ms, 15 % of the steps, all late.
-    assert p50 < 0.010 and p99 < 0.100, report
+    assert p50 < 0.020 and p99 < 0.150, report
     assert steps > 0.5 * wall / 0.012, report  # the ring bench's step: 12 ms
 
 
 if __name__ == "__main__":
     flood(int(sys.argv[1]), float(sys.argv[2]))
+
+
+def test_forty_flooding_connections_leave_the_simulation_its_steps_and_a_poller_its_latency():
+    """The issue's case: 40 connections pipelining flat out (in one other process) while one client polls.
+    Before the global budget: 81 % of the steps late. The benchmark (`python -m bench modbus`) reports the
+    figures (and `test_fair_share.py` checks the sharing itself, deterministically); here margins wide enough
+    for a 2-core machine shared with other work (the flood runs niced, so what is measured is the server's
+    own fairness, not the OS giving the flooder the server's core)."""
+    import os
+
+    from modbus_helpers import ROOT
+
+    with ServerProcess(RING_BENCH) as server, Raw(server.port) as other:
+        flooder = subprocess.Popen([sys.executable, "-m", "bench.flood", str(server.port), "40", "4.0"],
+                                   stdout=subprocess.PIPE, text=True, cwd=ROOT, preexec_fn=lambda: os.nice(10))
+        try:
+            time.sleep(0.7)  # the flood is on
+            step0, late0 = counters(other)
+            t0 = time.monotonic()
+            latencies = []
+            while time.monotonic() - t0 < 2.5:
+                t1 = time.perf_counter()
+                assert other.request(pdu(3, 16, 1))[:2] == b"\x03\x02"
+                latencies.append(time.perf_counter() - t1)
+                time.sleep(0.005)
+            step1, late1 = counters(other)
+            wall = time.monotonic() - t0
+            out, _ = flooder.communicate(timeout=30)
+        finally:
+            if flooder.poll() is None:
+                flooder.kill()
+                flooder.wait()
+    answered = int(out)
+    latencies.sort()
+    p99 = latencies[int(0.99 * (len(latencies) - 1))]
+    steps, late = step1 - step0, late1 - late0
+    report = (f"40 flooding: {answered} answered; poller p50 {statistics.median(latencies) * 1e3:.1f} ms, "
+              f"p99 {p99 * 1e3:.1f} ms; {steps} steps in {wall:.2f} s ({late} late)")
+    assert answered > 10000, report  # the flood itself was served
+    # Unfair (before the global budget): 81 % of the steps late on a quiet machine, all of them on a busy one.
+    # A loaded machine makes some steps late whatever the server does (the process waits for a core), so
+    # the margin is wide; the simulation still keeps real time on average (it catches up).
+    assert late <= 0.6 * steps, report
+    assert steps > 0.75 * wall / 0.012, report
+    assert p99 < 0.150, report

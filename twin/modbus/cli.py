@@ -351,7 +351,8 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
                           max_connections=get("max_connections", MAX_CONNECTIONS),
                           idle_timeout=get("idle_timeout", 0.0) or None, allow=get("allow", None),
                           read_only=get("read_only", False), gaps_zero=get("gaps", "error") == "zero",
-                          identity=device_identity(twin, rmap), on_request=on_request)
+                          identity=device_identity(twin, rmap), on_request=on_request,
+                          behind=(lambda: runner.last_late) if not lockstep else None)
     if profile is not None:
         from .profile import MAP_UNIT_ID, serve_profile
 

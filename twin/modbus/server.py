@@ -39,7 +39,9 @@ Wire behaviour
   connection that was idle goes before the ones with a backlog), so a client polling one request at a
   time is answered within about one step period however many others flood the server, and the
   simulation runner gets the loop between turns. A connection with a backlog is not read further
-  (TCP pushes back on its sender) until its backlog is answered.
+  (TCP pushes back on its sender) until its backlog is answered. The simulation comes first: while it
+  runs late (`behind()`: on a loaded machine the process may not get the CPU it needs), the budget is
+  halved each period (down to 1/16), and it grows back by a quarter per period once steps are on time.
 - Unit id: the server answers its `unit_id`, and 0 and 255 (which the TCP implementation guide uses for
   "this device"). Any other unit id gets exception 0B (gateway target device failed to respond).
 - Exceptions: the response's function code is the request's with the high bit set. An unknown function
@@ -80,8 +82,9 @@ from .register_map import RegisterMap
 MAX_LENGTH = 1 + 10 + 2 * 127  # MBAP length: unit id + function 23 writing 127 registers (byte count 254)
 REQUESTS_PER_STEP = 400  # global budget: requests answered per step period, over all connections
 SERVE_SHARE = 0.5  # at most this share of a step period's wall time goes to answering requests
+MIN_SCALE = 1 / 16  # however late the simulation, a period still answers this share of the budget
 TURN_SECONDS = 0.002  # one turn of answering gives the loop back after this long
-QUANTUM = 8  # requests of one connection answered in a row before the next connection's turn
+QUANTUM = 32  # requests of one connection answered in a row before the next connection's turn
 MAX_CONNECTIONS = 64
 READ_BACKLOG = 16384  # bytes buffered per connection before it is no longer read
 TLS_PORT = 802  # Modbus/TCP Security's registered port (mbap/TLS)
@@ -125,8 +128,8 @@ class ModbusServer:
                  serve_share: float = SERVE_SHARE, max_connections: int = MAX_CONNECTIONS,
                  idle_timeout: float | None = None, allow: Iterable | None = None, read_only: bool = False,
                  gaps_zero: bool = False, identity: DeviceIdentity | None = None,
-                 on_request: Callable[[str], None] | None = None, log: Callable[[str], None] = _log,
-                 clock: Callable[[], float] = time.perf_counter):
+                 on_request: Callable[[str], None] | None = None, behind: Callable[[], bool] | None = None,
+                 log: Callable[[str], None] = _log, clock: Callable[[], float] = time.perf_counter):
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
         self.units = {unit_id, 0, 255}
         self.pdus = PduHandler(rmap, backend, read_only=read_only, gaps_zero=gaps_zero, identity=identity)
@@ -136,6 +139,8 @@ class ModbusServer:
         self.max_connections, self.idle_timeout = max_connections, idle_timeout
         self.allow = tuple(allow) if allow is not None else None
         self.on_request = on_request
+        self.behind = behind  # the simulation is late: answer less until it has caught up
+        self.scale = 1.0  # the share of the budget in force (halved per late period, regrown when on time)
         self.log, self.clock = log, clock
         self.connections: set[_Connection] = set()
         self._servers: list[asyncio.base_events.Server] = []
@@ -187,8 +192,28 @@ class ModbusServer:
             if not any(addr in net for net in self.allow):
                 return "not in the allowed networks (--allow)"
         if len(self.connections) >= self.max_connections:
+            self._reap_closed()
+        if len(self.connections) >= self.max_connections:
             return f"{len(self.connections)} connections already, the limit (--max-connections)"
         return ""
+
+    def _reap_closed(self) -> None:
+        """At the limit: forget connections whose client has already closed (its end of file waits unread
+        behind the accept; a harness that connects and closes in a tight loop must not hit the limit)."""
+        for conn in list(self.connections):
+            sock = conn.transport.get_extra_info("socket") if conn.transport is not None else None
+            if sock is None:
+                continue
+            try:
+                with socket.fromfd(sock.fileno(), sock.family, sock.type) as peek:  # a dup: asyncio's has no recv
+                    gone = peek.recv(1, socket.MSG_PEEK | socket.MSG_DONTWAIT) == b""
+            except (BlockingIOError, InterruptedError):
+                gone = False
+            except OSError:
+                gone = True
+            if gone:
+                self.connections.discard(conn)
+                conn.close("closed by the client")
 
     def _sweep(self) -> None:
         """Close connections idle longer than `idle_timeout`; runs every quarter of it (at most 1 s)."""
@@ -224,16 +249,24 @@ class ModbusServer:
         now = clock()
         if now >= self._window + self.step_period:
             self._window, self._used, self._busy = now, 0, 0.0
-        budget = self.requests_per_step - self._used
-        time_left = min(TURN_SECONDS, self.serve_share * self.step_period - self._busy)
+            if self.behind is not None:
+                self.scale = max(MIN_SCALE, self.scale * 0.5) if self.behind() else min(1.0, self.scale * 1.25)
+        budget = int(self.requests_per_step * self.scale) - self._used
+        share = self.serve_share * self.scale * self.step_period
+        time_left = min(TURN_SECONDS, share - self._busy)
         t0 = now
         fresh, backlog = self._fresh, self._backlog
+        pass_left = quantum = 0
         while (fresh or backlog) and budget > 0 and clock() - t0 < time_left:
+            if pass_left == 0:  # a pass over the waiting connections: the budget left, split evenly
+                pass_left = len(fresh) + len(backlog)
+                quantum = max(1, min(QUANTUM, budget // pass_left))
+            pass_left -= 1
             conn = fresh.popleft() if fresh else backlog.popleft()
             conn.queued = False
             if conn.closed or conn.writing_paused:
                 continue
-            n = conn.answer(min(QUANTUM, budget))
+            n = conn.answer(min(quantum, budget))
             budget -= n
             self._used += n
             if n and self.on_request is not None:
@@ -244,7 +277,7 @@ class ModbusServer:
         self._busy += clock() - t0
         if fresh or backlog:
             loop = asyncio.get_running_loop()
-            if budget <= 0 or self._busy >= self.serve_share * self.step_period:
+            if budget <= 0 or self._busy >= share:
                 delay = max(0.0, self._window + self.step_period - clock())
                 self._scheduled = loop.call_later(delay, self._serve)
             else:

@@ -1,0 +1,75 @@
+"""The fair share, deterministically: a `ModbusServer` in process with real loopback connections and a
+frozen clock (one step period never ends until the test moves the clock)."""
+from __future__ import annotations
+
+import asyncio
+import struct
+
+from twin.modbus.bridge import TwinBridge
+from twin.modbus.register_map import build_register_map
+from twin.modbus.server import ModbusServer
+from twin.pacing import LockstepRunner
+
+from test_pacing_and_bridge import StandIn
+
+FRAME = struct.pack(">HHHBBHH", 1, 0, 6, 1, 4, 0, 2)  # FC 4, sim.step
+ANSWER = 7 + 2 + 4
+
+
+class Clock:
+    t = 100.0
+
+    def __call__(self) -> float:
+        return self.t
+
+
+async def count_answers(reader, counts, i):
+    while True:
+        data = await reader.read(1 << 16)
+        if not data:
+            return
+        counts[i] += len(data)
+
+
+def test_all_connections_share_one_budget_per_step_period_evenly_and_an_idle_one_goes_first():
+    async def run():
+        twin = StandIn()
+        rmap = build_register_map(twin.signals, "stand-in")
+        bridge = TwinBridge(twin, rmap, log=lambda text: None)
+        bridge.runner = LockstepRunner(bridge.step)
+        clock = Clock()
+        server = ModbusServer(rmap, bridge, requests_per_step=120, step_period=0.02, clock=clock, log=lambda t: None)
+        _, port = await server.start("127.0.0.1", 0)
+        n = 40
+        conns = [await asyncio.open_connection("127.0.0.1", port) for _ in range(n)]
+        counts = [0] * (n + 1)
+        readers = [asyncio.ensure_future(count_answers(r, counts, i)) for i, (r, _) in enumerate(conns)]
+        for _, w in conns:
+            w.write(FRAME * 300)  # 300 pipelined requests each: 12000 in all
+        await asyncio.sleep(0.3)  # many loop turns, but the clock stands: one step period
+        assert sum(counts[:n]) // ANSWER == 120  # the budget, over all connections
+        for _ in range(9):  # nine more periods
+            clock.t += 0.02
+            await asyncio.sleep(0.1)
+        first = [c // ANSWER for c in counts[:n]]
+        assert sum(first) == 1200, first
+        assert max(first) - min(first) <= 4, first  # about 30 each: split evenly (arrival order aside)
+        # an idle client asks once: the next period serves it first, before the backlog
+        pr, pw = await asyncio.open_connection("127.0.0.1", port)
+        pw.write(FRAME)
+        await asyncio.sleep(0.05)
+        assert not pr._buffer  # still the same period: nothing more is answered
+        clock.t += 0.02
+        head = await asyncio.wait_for(pr.readexactly(ANSWER), 2.0)
+        assert head[7] == 4
+        await asyncio.sleep(0.05)
+        second = [c // ANSWER - f for c, f in zip(counts[:n], first)]
+        assert sum(second) == 119, second  # the period's budget less the idle client's request
+        assert max(second) - min(second) <= 1, second
+        for _, w in conns + [(pr, pw)]:
+            w.close()
+        await server.close()
+        for r in readers:
+            r.cancel()
+
+    asyncio.run(run())
