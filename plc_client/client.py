@@ -41,6 +41,7 @@ Signal = Entry  # one entry of the register map, as the server builds it (twin.m
 WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
 MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
 MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
+MAX_RW_WRITE = 121
 FLOAT32_MAX = 3.4028234663852886e38
 
 
@@ -272,6 +273,28 @@ def plan_reads(signals: Iterable[Signal], mapped: Mapping[str, set[int]] | None 
     return runs
 
 
+class WindowImage:
+    """The server's input window as read in one request: every signal's value, and the output window's
+    current words (coils and holding registers read back), to fill a write block."""
+
+    def __init__(self, client: "TwinClient", words: list[int]):
+        self.client, self.words = client, words
+        self.layout = client.layout
+
+    def value(self, s: Signal) -> Any:
+        k, n = self.layout.in_words(s)
+        if s.table in BIT_TABLES:
+            return decode(s, [(self.words[k] >> (s.address % 16)) & 1])
+        return decode(s, self.words[k:k + n])
+
+    def out_word(self, k: int) -> int:
+        """The current value of word k of the output window."""
+        lay = self.layout
+        if k < lay.out_offset[HOLDING_REGISTER]:
+            return (self.words[lay.in_offset[COIL] + k // 16] >> (k % 16)) & 1
+        return self.words[lay.in_offset[HOLDING_REGISTER] + k - lay.out_offset[HOLDING_REGISTER]]
+
+
 class TwinClient:
     """A connection to a twin server, signals by name (see the module's docstring)."""
 
@@ -413,7 +436,11 @@ class TwinClient:
         try:
             with self._lock:
                 self._last_request = time.monotonic()
-                response = getattr(self._client, method)(address, *args, device_id=self.unit_id, **kw)
+                call = getattr(self._client, method)
+                if method == "readwrite_registers":  # keyword arguments only
+                    response = call(device_id=self.unit_id, **kw)
+                else:
+                    response = call(address, *args, device_id=self.unit_id, **kw)
         except ModbusException as exc:
             raise ConnectionFailedError(self.host, self.port, str(exc).strip() or type(exc).__name__) from None
         except OSError as exc:
@@ -435,6 +462,73 @@ class TwinClient:
                 off = s.address - run.start
                 values[s.name] = decode(s, list(words[off:off + s.count]))
         return values
+
+    # -- the process-image windows (twin.modbus.pdu.ImageLayout): a scan in one or two requests ----------
+    @property
+    def layout(self):
+        """Where each table sits in the server's process-image windows (computed from the map, as the server does)."""
+        if getattr(self, "_layout", None) is None:
+            from twin.modbus.pdu import ImageLayout
+
+            sizes = {t: max((s.address + s.count for s in self.map if s.table == t), default=0) for t in TABLES}
+            self._layout = ImageLayout(sizes)
+        return self._layout
+
+    @property
+    def windows_fit(self) -> bool:
+        """The whole input window fits one read (125 registers) and the output window one function 23 write."""
+        return self.layout.in_size <= MAX_REGISTERS and 0 < self.layout.out_size <= MAX_RW_WRITE
+
+    def read_window(self) -> "WindowImage":
+        """The whole input window in one request (function 3)."""
+        from twin.modbus.pdu import IMAGE_IN
+
+        n = self.layout.in_size
+        r = self._call(3, "read_holding_registers", IMAGE_IN, n, (), count=n)
+        return WindowImage(self, list(r.registers))
+
+    def exchange(self, values: Mapping[str, Any], image: "WindowImage", advance: int = 0) -> "WindowImage":
+        """Write `values` (names in engineering units, and `advance` steps of sim.advance) into the output
+        window and read the whole input window back, in one function 23. In lockstep with `advance`, the
+        server answers once the steps are done, so the image returned is the state after them. `image`
+        (the last one read) gives the current values of the words between the ones written."""
+        from twin.modbus.pdu import IMAGE_IN, IMAGE_OUT
+
+        words = self._out_words(values, image, advance)
+        if words is None:
+            raise PlcClientError("the output window cannot be filled from the last image")
+        start, block = words
+        n = self.layout.in_size
+        r = self._call(23, "readwrite_registers", IMAGE_OUT + start, n, [self.map[k] for k in values],
+                       read_address=IMAGE_IN, read_count=n, write_address=IMAGE_OUT + start, values=block)
+        return WindowImage(self, list(r.registers))
+
+    def write_window(self, values: Mapping[str, Any], image: "WindowImage") -> None:
+        """Write `values` into the output window in one request (function 16)."""
+        from twin.modbus.pdu import IMAGE_OUT
+
+        start, block = self._out_words(values, image, 0)
+        self._call(16, "write_registers", IMAGE_OUT + start, len(block), [self.map[k] for k in values], block)
+
+    def _out_words(self, values: Mapping[str, Any], image: "WindowImage", advance: int):
+        """(first word, words) of the output window covering `values` (and sim.advance), the words between
+        them filled with the values `image` holds (so they are written unchanged)."""
+        lay = self.layout
+        mine: dict[int, int] = {}
+        for name, value in values.items():
+            s = self.map[name]
+            k, n = lay.out_words(s)
+            ws = [int(w) for w in encode(s, self.map.check_value(name, value))]
+            for i in range(n):
+                mine[k + i] = ws[i]
+        if advance:
+            s = self.map[ADVANCE]
+            mine[lay.out_words(s)[0]] = int(advance)
+        lo, hi = min(mine), max(mine)
+        if hi - lo + 1 > MAX_RW_WRITE:
+            return None
+        block = [mine[k] if k in mine else image.out_word(k) for k in range(lo, hi + 1)]
+        return lo, block
 
     # -- by name ------------------------------------------------------------------------------------
     def read(self, *names: str) -> dict[str, Any]:
@@ -532,25 +626,65 @@ class ClientIO(LocalSignals):
     Lockstep (the server was started with `--lockstep`): each scan runs `cycle / dt` steps through
     `sim.advance` (carried over, so the average matches); otherwise the scan cycle paces itself against the
     wall clock and the server runs in real time. `local`: signals the PLC holds itself (see `LocalSignals`).
+
+    The process image travels through the server's process-image windows (`twin.modbus.pdu.ImageLayout`)
+    when they fit one request each, as a real PLC's I/O exchange does: in lockstep one function 23 per scan
+    (the outputs and sim.advance written, the inputs read back once the steps are done), in real time one
+    read of the input window and, when an output changed, one write of the output window. `requests` counts
+    what went on the wire. `exchange=False` reads and writes signal by signal (several requests a scan).
     """
 
     def __init__(self, client: TwinClient, *, lockstep: bool | None = None, dt: float | None = None,
-                 local: Mapping[str, Any] | None = None):
+                 local: Mapping[str, Any] | None = None, exchange: bool = True):
         super().__init__(local)
         self.client = client
         self.lockstep = client.lockstep if lockstep is None else lockstep
         self.dt = dt or client.dt
         self._time, self._steps = 0.0, 0
+        self.exchange = exchange and client.windows_fit
+        self._image: WindowImage | None = None  # the input window as last read
+        self._fresh = False  # it shows the process as it is now (lockstep: read after the last steps)
+        self._pending: dict[str, Any] = {}  # lockstep: outputs to write with the next advance
 
     def _read(self, names: list[str]) -> dict[str, Any]:
-        return self.client.read(*names) if names else {}
+        if not names:
+            return {}
+        if not self.exchange:
+            return self.client.read(*names)
+        signals = self.client.map.check_names(names)
+        if not self._fresh or self._image is None:
+            self._image = self.client.read_window()
+        self._fresh = self.lockstep  # real time: the next scan reads anew; lockstep: until the next advance
+        return {s.name: self._image.value(s) for s in signals}
 
     def _write(self, values: dict[str, Any]) -> None:
-        self.client.write(values)
+        if not self.exchange:
+            self.client.write(values)
+            return
+        for name, value in values.items():
+            self.client.map.check_value(name, value)  # refused here, at the scan that set it
+        if ADVANCE in values or self._image is None:
+            self.client.write(values)
+            self._fresh = False
+        elif self.lockstep:
+            self._pending.update(values)
+        else:
+            self.client.write_window(values, self._image)
 
     def advance(self, seconds: float) -> None:
         self._time += seconds
         target = math.floor(self._time / self.dt + 1e-9)
-        if target > self._steps:
-            self.client.advance(target - self._steps)
+        steps = max(0, target - self._steps)
+        if self.exchange and self._image is not None and (steps or self._pending):
+            pending, self._pending = self._pending, {}
+            self._image = self.client.exchange(pending, self._image, advance=steps)
+            self._fresh = True
             self._steps = target
+            return
+        if self._pending:
+            pending, self._pending = self._pending, {}
+            self.client.write(pending)
+        if steps:
+            self.client.advance(steps)
+            self._steps = target
+            self._fresh = False

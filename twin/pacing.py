@@ -112,6 +112,7 @@ class LockstepRunner:
         self.step, self.slice_s, self.clock = step, slice_s, clock
         self.steps = 0
         self.target = 0
+        self._done: list[Callable[[], None]] = []  # called when the steps asked for are done (or failed)
         self._wake: asyncio.Event | None = None
         self._stop = False
         self.failed = False
@@ -127,16 +128,31 @@ class LockstepRunner:
         if self._wake is not None:
             self._wake.set()
 
+    def when_done(self, callback: Callable[[], None]) -> None:
+        """Call `callback()` once every step asked for so far has run (at once when none is left)."""
+        if self.steps >= self.target or self.failed:
+            callback()
+        else:
+            self._done.append(callback)
+
+    def _call_done(self) -> None:
+        done, self._done = self._done, []
+        for callback in done:
+            callback()
+
     def stop(self) -> None:
         self._stop = True
         if self._wake is not None:
             self._wake.set()
+        self._call_done()
 
     async def run(self) -> None:
         self._wake = asyncio.Event()
         clock = self.clock
         while not self._stop:
             if self.steps >= self.target:
+                if self._done:
+                    self._call_done()
                 self._wake.clear()
                 await self._wake.wait()
                 continue
@@ -145,8 +161,11 @@ class LockstepRunner:
                 if not self.step():
                     self.failed = True
                     self.target = self.steps
+                    self._call_done()
                     return
                 self.steps += 1
+                if self.steps >= self.target and self._done:
+                    self._call_done()
                 if clock() >= t_yield:
                     break
             await asyncio.sleep(0)

@@ -90,6 +90,16 @@ class TwinBridge:
         if changed:
             self.images = dataclasses.replace(self.images, **changed)
 
+    def stepping(self) -> bool:
+        runner = self.runner
+        return runner is not None and runner.mode == "lockstep" and runner.remaining > 0
+
+    def when_stepped(self, callback) -> None:
+        if not self.stepping() or self.fault:
+            callback()
+        else:
+            self.runner.when_done(callback)
+
     def live_holding(self, address: int) -> int | None:
         if self._advance is not None and address == self._advance.address:
             return 0 if self.runner is None else min(0xFFFF, self.runner.remaining)

@@ -50,6 +50,12 @@ class Backend(Protocol):
     def live_holding(self, address: int) -> int | None:
         """A holding register whose value is live rather than from the last step (e.g. sim.advance)."""
 
+    def stepping(self) -> bool:
+        """Lockstep steps asked for are still to run (a function 23 that asked for them waits: `Deferred`)."""
+
+    def when_stepped(self, callback) -> None:
+        """Call `callback()` once the steps asked for are done (at once if none are left)."""
+
 
 # -- device identification (6.21) ---------------------------------------------------------------------
 BASIC, REGULAR, EXTENDED, INDIVIDUAL = 1, 2, 3, 4
@@ -87,6 +93,49 @@ def _category(object_id: int) -> int:
     return BASIC if object_id <= 2 else REGULAR if object_id <= 0x7F else EXTENDED
 
 
+# -- the process-image window (one read, one write or one function 23 per PLC scan) --------------------
+IMAGE_IN, IMAGE_OUT = 0x8000, 0xC000  # holding-register addresses of the two windows
+
+
+class ImageLayout:
+    """Where each table sits in the process-image windows, derived from the map's table sizes alone (so
+    the client computes the same layout from the same map).
+
+    - The input window (read-only, from holding register 0x8000): the discrete inputs packed 16 to a word
+      (discrete input 16*k + i is bit i of word k), the input registers one to one, the coils packed like
+      the discrete inputs, then the holding registers one to one. Unmapped addresses read 0.
+    - The output window (from 0xC000): one word per coil (0 or 1), then the holding registers one to one.
+      A write here is a write of the entries it covers, all or nothing, checked as any write; words over
+      unmapped addresses are ignored, a read-only entry may only be written with the value it has."""
+
+    def __init__(self, sizes: dict[str, int]):
+        self.sizes = dict(sizes)
+        di_words, coil_words = (sizes[DISCRETE_INPUT] + 15) // 16, (sizes[COIL] + 15) // 16
+        self.in_offset = {DISCRETE_INPUT: 0, INPUT_REGISTER: di_words,
+                          COIL: di_words + sizes[INPUT_REGISTER],
+                          HOLDING_REGISTER: di_words + sizes[INPUT_REGISTER] + coil_words}
+        self.in_size = self.in_offset[HOLDING_REGISTER] + sizes[HOLDING_REGISTER]
+        self.out_offset = {COIL: 0, HOLDING_REGISTER: sizes[COIL]}
+        self.out_size = sizes[COIL] + sizes[HOLDING_REGISTER]
+
+    def in_words(self, entry) -> tuple[int, int]:
+        """(first word, words) of an entry in the input window (relative to IMAGE_IN)."""
+        base = self.in_offset[entry.table]
+        if entry.table in (COIL, DISCRETE_INPUT):
+            return base + entry.address // 16, 1
+        return base + entry.address, entry.count
+
+    def out_words(self, entry) -> tuple[int, int]:
+        return self.out_offset[entry.table] + entry.address, entry.count
+
+
+class Deferred:
+    """A response that waits: function 23 that set sim.advance answers once the steps are done."""
+
+    def __init__(self, finish):
+        self.finish = finish  # () -> the response PDU
+
+
 class _Table:
     """Address bookkeeping for one table: which addresses are mapped, where entries start."""
 
@@ -115,6 +164,16 @@ class _Table:
 _ASCII_BITS = bytes.maketrans(b"\x00\x01", b"01")
 
 
+def _patched(backend, holding: bytes) -> bytes:
+    """The holding-register image with its live registers (sim.advance) filled in."""
+    out = bytearray(holding)
+    for a in backend.live_addresses:
+        v = backend.live_holding(a)
+        if v is not None and 2 * a + 2 <= len(out):
+            struct.pack_into(">H", out, 2 * a, v)
+    return bytes(out)
+
+
 def pack_bits(bits: bytes) -> bytes:
     """Bytes of 0/1 -> Modbus bit packing (first bit in the low bit of the first byte)."""
     if not bits:
@@ -133,6 +192,8 @@ class PduHandler:
         self.map, self.backend = rmap, backend
         self.read_only, self.gaps_zero = read_only, gaps_zero
         self.tables = {t: _Table(rmap, t, gaps_zero) for t in TABLES}
+        self.layout = ImageLayout({t: self.tables[t].size for t in TABLES})
+        self._in_cache: tuple[object, bytes] | None = None
         self.identity = identity or DeviceIdentity()
         self.id_objects = self.identity.objects()
         self.requests = 0
@@ -182,6 +243,8 @@ class PduHandler:
 
     def registers(self, table: str, address: int, count: int):
         """The words at address..address+count as bytes, or exception 02."""
+        if table == HOLDING_REGISTER and address >= IMAGE_IN:
+            return self._window(address, count)
         if not self.tables[table].readable(address, count):
             return ILLEGAL_DATA_ADDRESS
         images = self.backend.images
@@ -198,9 +261,88 @@ class PduHandler:
                     struct.pack_into(">H", patched, 2 * (a - address), v)
         return data if patched is None else bytes(patched)
 
+    def _window(self, address: int, count: int):
+        lay = self.layout
+        if address >= IMAGE_OUT:
+            start, size = address - IMAGE_OUT, lay.out_size
+        else:
+            start, size = address - IMAGE_IN, lay.in_size
+        if start + count > size:
+            return ILLEGAL_DATA_ADDRESS
+        if address >= IMAGE_OUT:
+            images = self.backend.images
+            window = b"".join(b"\x00" + bytes((b,)) for b in images.coils) + _patched(self.backend, images.holding)
+        else:
+            window = self._input_window()
+        return window[2 * start:2 * (start + count)]
+
+    def _input_window(self) -> bytes:
+        images = self.backend.images
+        live = [self.backend.live_holding(a) for a in sorted(self.backend.live_addresses)]
+        key = (images, tuple(live))
+        if self._in_cache is not None and self._in_cache[0] == key:
+            return self._in_cache[1]
+        lay = self.layout
+
+        def packed(bits: bytes, words: int) -> bytes:
+            data = pack_bits(bits).ljust(2 * words, b"\x00")
+            return b"".join(data[i + 1:i + 2] + data[i:i + 1] for i in range(0, 2 * words, 2))  # word k: bits 16k..16k+15
+
+        holding = _patched(self.backend, images.holding)
+        window = (packed(images.discrete_inputs, lay.in_offset[INPUT_REGISTER]) + images.input_registers
+                  + packed(images.coils, lay.in_offset[HOLDING_REGISTER] - lay.in_offset[COIL]) + holding)
+        self._in_cache = (key, window)
+        return window
+
+    def _write_window(self, address: int, words: Sequence[int]) -> int:
+        """A write into the output window: the entries it covers, all or nothing (see ImageLayout)."""
+        lay = self.layout
+        start = address - IMAGE_OUT
+        if address < IMAGE_OUT or start + len(words) > lay.out_size:
+            return ILLEGAL_DATA_ADDRESS
+        changes = []
+        images = self.backend.images
+        current_h = None
+        k, end = start, start + len(words)
+        while k < end:
+            if k < lay.out_offset[HOLDING_REGISTER]:
+                table, a = COIL, k
+            else:
+                table, a = HOLDING_REGISTER, k - lay.out_offset[HOLDING_REGISTER]
+            t = self.tables[table]
+            e = t.entry_at.get(a)
+            if e is None:
+                if t.valid[a]:  # inside an entry that starts before the write: only part of it
+                    return ILLEGAL_DATA_ADDRESS
+                k += 1  # an unmapped address: ignored
+                continue
+            if k + e.count > end:
+                return ILLEGAL_DATA_ADDRESS
+            chunk = list(words[k - start:k - start + e.count])
+            if table == COIL:
+                if chunk[0] not in (0, 1):
+                    return ILLEGAL_DATA_VALUE
+                same = images.coils[a] == chunk[0]
+            else:
+                if current_h is None:
+                    current_h = _patched(self.backend, images.holding)
+                same = list(struct.unpack_from(f">{e.count}H", current_h, 2 * a)) == chunk
+            if not e.writable:
+                if not same:
+                    return ILLEGAL_DATA_ADDRESS
+            else:
+                value = e.si_of_words(chunk)
+                if value is None:
+                    return ILLEGAL_DATA_VALUE
+                changes.append((e, value))
+            k += e.count
+        return self.backend.submit(changes) if changes else 0
+
     # -- writes ---------------------------------------------------------------------------------------
     def _write(self, table: str, address: int, words: Sequence[int]) -> int:
         """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code."""
+        if table == HOLDING_REGISTER and address >= IMAGE_OUT:
+            return self._write_window(address, words)
         t = self.tables[table]
         if not t.writable(address, len(words)):
             return ILLEGAL_DATA_ADDRESS
@@ -271,14 +413,31 @@ class PduHandler:
         if (not 1 <= rcount <= MAX_RW_READ or not 1 <= wcount <= MAX_RW_WRITE or nbytes != 2 * wcount
                 or len(pdu) != 10 + nbytes):
             return ILLEGAL_DATA_VALUE
-        if not self.tables[HOLDING_REGISTER].readable(raddr, rcount):
+        if raddr < IMAGE_IN and not self.tables[HOLDING_REGISTER].readable(raddr, rcount):
+            return ILLEGAL_DATA_ADDRESS
+        if raddr >= IMAGE_IN and isinstance(self._window(raddr, rcount), int):
             return ILLEGAL_DATA_ADDRESS
         # The spec's order: the write first, then the read (which sees the write).
-        code = self._write(HOLDING_REGISTER, waddr, struct.unpack_from(f">{wcount}H", pdu, 10))
+        words = struct.unpack_from(f">{wcount}H", pdu, 10)
+        code = self._write(HOLDING_REGISTER, waddr, words)
         if code:
             return code
-        data = self.registers(HOLDING_REGISTER, raddr, rcount)
-        return bytes((23, len(data))) + data
+
+        def read():
+            data = self.registers(HOLDING_REGISTER, raddr, rcount)
+            return bytes((23, len(data))) + data
+
+        if self._advances(waddr, words) and self.backend.stepping():
+            return Deferred(read)  # lockstep: the read sees the state after the steps asked for
+        return read()
+
+    def _advances(self, address: int, words: Sequence[int]) -> bool:
+        """The write sets sim.advance to a number of steps (directly, or through the output window)."""
+        adv = self.map.by_name.get("sim.advance")
+        if adv is None or adv.table != HOLDING_REGISTER:
+            return False
+        at = adv.address if address < IMAGE_OUT else IMAGE_OUT + self.layout.out_offset[HOLDING_REGISTER] + adv.address
+        return address <= at < address + len(words) and words[at - address] != 0
 
     # -- 43/14: read device identification (6.21) -----------------------------------------------------
     def _encapsulated(self, pdu: bytes):

@@ -76,7 +76,7 @@ from collections.abc import Callable, Iterable
 
 from .log import log as _log
 from .pdu import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
-                  SERVER_DEVICE_FAILURE, Backend, DeviceIdentity, Images, PduHandler)
+                  SERVER_DEVICE_FAILURE, Backend, Deferred, DeviceIdentity, Images, PduHandler)
 from .register_map import RegisterMap
 
 MAX_LENGTH = 1 + 10 + 2 * 127  # MBAP length: unit id + function 23 writing 127 registers (byte count 254)
@@ -297,6 +297,7 @@ class _Connection(asyncio.Protocol):
         self.writing_paused = False
         self.reading_paused = False
         self.queued = False
+        self.waiting = False  # a deferred answer (function 23 with sim.advance in lockstep) is pending
         self.closed = False
         self.admitted = False
         self.peer = "?"
@@ -393,6 +394,10 @@ class _Connection(asyncio.Protocol):
             return
         fresh = not self.buf
         self.buf += data
+        if self.waiting:  # a deferred answer first: keep what comes, answer it afterwards
+            if len(self.buf) >= READ_BACKLOG:
+                self._pause_reading()
+            return
         if self.has_request():
             self._stop_timer()
             if not self.queued and not self.writing_paused:
@@ -405,7 +410,7 @@ class _Connection(asyncio.Protocol):
     def has_request(self) -> bool:
         """A complete frame (or a header that cannot be framed, to be refused) waits at the front."""
         buf = self.buf
-        if len(buf) < 7:
+        if len(buf) < 7 or self.waiting:
             return False
         _, pid, length, _ = _HDR.unpack_from(buf, 0)
         return pid != 0 or not 2 <= length <= MAX_LENGTH or len(buf) >= 6 + length
@@ -429,9 +434,13 @@ class _Connection(asyncio.Protocol):
             if n - pos < 6 + length:
                 break
             response = handle(unit, bytes(buf[pos + 7:pos + 6 + length]))
-            out.append(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
             pos += 6 + length
             count += 1
+            if isinstance(response, Deferred):  # answered once the lockstep steps are done; later ones wait
+                self.waiting = True
+                self.server.backend.when_stepped(lambda: self._finish(tid, unit, response))
+                break
+            out.append(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
         if pos:
             del buf[:pos]
             self.last_request = asyncio.get_running_loop().time()
@@ -446,6 +455,21 @@ class _Connection(asyncio.Protocol):
             self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
         return count
 
+    def _finish(self, tid: int, unit: int, deferred: Deferred) -> None:
+        """The steps a function 23 asked for are done: its answer (the read after them), then go on."""
+        self.waiting = False
+        if self.closed:
+            return
+        response = deferred.finish()
+        self.transport.write(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
+        if self.has_request():
+            if not self.queued and not self.writing_paused:
+                self.server.want_turn(self, fresh=False)
+        elif self.buf and self.timer is None:
+            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+        if not self.writing_paused and len(self.buf) < READ_BACKLOG:
+            self._resume_reading()
+
     def _stop_timer(self) -> None:
         if self.timer is not None:
             self.timer.cancel()
@@ -453,6 +477,6 @@ class _Connection(asyncio.Protocol):
 
     def _stalled(self) -> None:
         self.timer = None
-        if self.has_request() or self.closed:
+        if self.has_request() or self.closed or self.waiting:
             return
         self.close(f"half a frame ({len(self.buf)} bytes) not completed within {self.server.frame_timeout:g} s")
