@@ -11,6 +11,7 @@ BENCHMARKS = {
     "core": "bench.core_step",  # simulation steps per second, grip-check cost vs target count
     "modbus": "bench.modbus_latency",  # twin serve vs bare pymodbus: latency, throughput, late steps
     "cell": "bench.cell",  # the full cycle: the PLC in process vs across Modbus/TCP, lockstep
+    "campaign": "bench.campaign",  # scenarios/min and parallel efficiency, local pool vs Dask on loopback
 }
 
 

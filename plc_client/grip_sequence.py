@@ -108,7 +108,9 @@ class GripSequence:
     travel_speed    ramp speed of a prepare move, where nothing is touched (default: `speed`)
     threshold       force every finger must reach for a confirmed grip
     close_direction per mode, +1 or -1: which way a grip moves the setpoints (outside closes: -1)
-    contacts        optional contact signal names (bool, one per finger): a part is free only when none is set
+    contacts        optional contact signal names (bool, one per finger): a grip is confirmed only when every one
+                    is set too (a finger jammed before the part has force but no contact), and a part is free
+                    only when none is set
     free_force      a part is free when every finger's force is below this
     release_margin  after the part is free, open this much further
     release_limit   per mode: the furthest a release may open (default: `release_travel` from where it starts)
@@ -215,6 +217,9 @@ class GripSequence:
         release_edge = self._edge(inputs, state, h.release_request)
         prepare_edge = self._edge(inputs, state, h.prepare_request) if h.prepare_request else False
         forces = [float(inputs[n]) for n in self.forces]
+        # with contact signals, a grip is confirmed only when every finger touches the part too: a finger that
+        # presses on something else (a jam, an obstacle) has force but no part
+        touching = all(bool(inputs[n]) for n in self.contacts) if self.contacts else True
         actual = {a: float(inputs[n]) for a, n in zip(self.axes, self.actuals)}
         out: dict = {}
 
@@ -241,7 +246,7 @@ class GripSequence:
                 state.setpoint, state.at_end_since = dict(actual), None
 
         if state.phase is Phase.GRIPPING:
-            self._grip_scan(state, forces, actual, elapsed, now)
+            self._grip_scan(state, forces, actual, elapsed, now, touching)
         elif state.phase is Phase.RELEASING:
             self._release_scan(inputs, state, forces, actual, elapsed, now)
         elif state.phase is Phase.PREPARING:
@@ -284,8 +289,8 @@ class GripSequence:
         return rising
 
     def _grip_scan(self, state: GripState, forces: list[float], actual: dict[str, float], elapsed: float,
-                   now: float) -> None:
-        if all(f >= self.threshold for f in forces):
+                   now: float, touching: bool = True) -> None:
+        if all(f >= self.threshold for f in forces) and touching:
             state.phase, state.held_at = Phase.HELD, dict(state.setpoint)
             state.forces_at_grip = dict(zip(self.forces, forces))
             return

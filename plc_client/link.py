@@ -14,7 +14,8 @@ PLC writes its output image every cycle). Latency delays both ways: the PLC read
 much later, in the order sent. Lockstep advances are the test's clock, not the link: they always pass.
 
 The PLC can see its link's state as the input `link.ok` (True while the link is up), as a real PLC
-sees its communication status.
+sees its communication status. `on_exchange` is called for every read that gets through: in process, feed
+the cell's comm-loss watchdog with it (`twin.watchdog.feed`), as the server does for every request.
 """
 from __future__ import annotations
 
@@ -32,8 +33,10 @@ class LinkFaults:
     """Wraps a `ProcessIO`: `lost` windows [(start, end), ...] in s, `latency` and `jitter` in s."""
 
     def __init__(self, io, *, lost: Iterable[tuple[float, float]] = (), latency: float = 0.0, jitter: float = 0.0,
-                 seed: int = 0, clock: Callable[[], float] | None = None):
+                 seed: int = 0, clock: Callable[[], float] | None = None,
+                 on_exchange: Callable[[], None] | None = None):
         self.io = io
+        self.on_exchange = on_exchange  # called for every exchange that gets through (e.g. a watchdog's feed)
         self.lockstep = getattr(io, "lockstep", True)
         self.lost = sorted((float(a), float(b)) for a, b in lost)
         for a, b in self.lost:
@@ -82,6 +85,8 @@ class LinkFaults:
         wanted = [n for n in names if n != LINK_OK]
         if self.up(now):
             self._history.append((now, self.io.read_image(wanted)))
+            if self.on_exchange is not None:
+                self.on_exchange()
             delay = self._delay()
             image = self._history[-1][1]
             if delay:

@@ -103,12 +103,13 @@ def twin_command() -> list[str]:
 @contextlib.contextmanager
 def twin_server(station: str | Path, *, lockstep: bool = True, speed: float | None = None, host: str = LOOPBACK,
                 port: int = 0, unit_id: int = 1, startup_timeout: float = 30.0,
-                extra_args: list[str] = ()) -> Iterator[TwinServer]:
+                extra_args: list[str] = (), faults: str | Path | None = None) -> Iterator[TwinServer]:
     """Start `twin serve STATION` on loopback, wait until it listens, and stop it afterwards.
 
     port 0 (the default): the server binds a free port and says which (no race with other tests).
     lockstep: the server only steps when told (`sim.advance`): the same run gives the same result. Else it
-    runs in real time, or at `speed` times real time.
+    runs in real time, or at `speed` times real time. `faults`: a faults file (`[faults.NAME]` tables as in a
+    campaign, docs/campaigns.md) whose plant faults the served twin meets (`twin serve --faults`).
     """
     station = Path(station)
     rmap = RegisterMap.from_station(station)
@@ -116,7 +117,8 @@ def twin_server(station: str | Path, *, lockstep: bool = True, speed: float | No
     with tempfile.NamedTemporaryFile(mode="w+", prefix="twin-serve-", suffix=".log", delete=False) as log:
         log_path = Path(log.name)
         proc = subprocess.Popen([*twin_command(), "serve", str(station), "--host", host, "--port", str(port),
-                                 "--unit-id", str(unit_id), *mode, *extra_args],
+                                 "--unit-id", str(unit_id), *mode,
+                                 *(["--faults", str(faults)] if faults else []), *extra_args],
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log)
     server = None
     try:

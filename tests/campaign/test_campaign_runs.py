@@ -123,3 +123,14 @@ def test_the_command_prints_a_summary_and_exits_by_the_verdict(tmp_path):
     assert "2 of 2 scenarios run: 2 passed, 0 failed, 0 errors" in proc.stdout
     assert "[2/2] pass 2 fail 0 error 0" in proc.stderr  # the progress line
     assert (tmp_path / "junit.xml").exists() and (tmp_path / "results.csv").exists()
+
+
+def test_without_a_fork_server_each_scenario_is_a_fresh_interpreter(tmp_path, monkeypatch):
+    import twin.campaign.backends as backends
+
+    monkeypatch.setattr(backends, "_may_fork", lambda: False)
+    campaign = load_campaign(DATA / "crash.toml")
+    result = run_campaign(campaign, LocalBackend(2, timeout=30.0), tmp_path, indices=[0, 1], quiet=True)
+    status = {r["params"]["var.mode"]: r for r in result.records}
+    assert status["ok"]["status"] == "pass" and status["ok"]["measured"]["l2_mm"] == pytest.approx(325.0, abs=0.5)
+    assert status["crash"]["status"] == "error" and "SIGABRT" in status["crash"]["measured"]["message"]

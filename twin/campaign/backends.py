@@ -3,8 +3,8 @@
 `LocalBackend(workers)`: every scenario in a process of its own, forked from a fork server that has
 imported the simulation once, at most `workers` at a time. A scenario that kills its process (a native
 crash, `os.abort()`) or outlives its timeout (it is killed) fails alone, with the reason; the others
-run on. Inside a daemonic process, where forking children is not allowed (a Dask worker under its
-nanny), each scenario is a fresh interpreter instead (`python -m twin.campaign.worker`).
+run on. Where the fork server is not available (Windows), each scenario is a fresh interpreter instead
+(`python -m twin.campaign.worker`).
 
 `DaskBackend(address)`: the same isolation on each worker of an existing Dask cluster (`dask scheduler`,
 `dask worker ADDRESS`): a task runs its scenario in a fresh local process, so a crash never takes a
@@ -146,6 +146,19 @@ class _SpawnJob:
                 pass
 
 
+def _may_fork() -> bool:
+    """Whether this process may start children. A daemonic process (a Dask worker under its nanny) may
+    not, unless it says it is not daemonic: it may, since it waits for each of its scenario processes
+    (themselves daemonic: they die with it)."""
+    me = multiprocessing.current_process()
+    if me.daemon:
+        try:
+            me.daemon = False
+        except AssertionError:  # a process object that has started its own: leave it alone
+            return False
+    return True
+
+
 def _fork_context():
     ctx = multiprocessing.get_context("forkserver")
     ctx.set_forkserver_preload(["twin.campaign.worker"])
@@ -165,7 +178,7 @@ class LocalBackend:
     def run(self, campaign, indices: Iterable[int], on_result: OnResult) -> None:
         timeout = self.timeout if self.timeout is not None else campaign.timeout
         pending = list(indices)
-        forking = not multiprocessing.current_process().daemon and "forkserver" in multiprocessing.get_all_start_methods()
+        forking = _may_fork() and "forkserver" in multiprocessing.get_all_start_methods()
         ctx = _fork_context() if forking else None
         running: dict[int, tuple[object, float, float]] = {}
         logdir = tempfile.TemporaryDirectory(prefix="campaign-logs-")
@@ -217,7 +230,7 @@ class DaskBackend:
 
     name = "dask"
 
-    def __init__(self, address: str, timeout: float | None = None, connect_timeout: float = 30.0):
+    def __init__(self, address: str, timeout: float | None = None, connect_timeout: float = 10.0):
         try:
             import distributed  # noqa: F401
         except ImportError:

@@ -73,9 +73,12 @@ def run_campaign(campaign: Campaign, backend, out_dir: str | Path, *, resume: bo
         sc = campaign.scenarios[index]
         measured = envelope["measured"]
         status, failures = judge(campaign, sc, measured)
+        if status == "pass":
+            measured.pop("trace", None)  # traces are kept for the failing scenarios' plots only
         rec = {"index": index, "key": sc.key, "name": sc.name, "params": sc.params, "measured": measured,
                "status": status, "failures": failures, "wall": envelope.get("wall", 0.0),
-               "wall_run": envelope.get("wall_run")}
+               "wall_run": envelope.get("wall_run"), "wall_load": envelope.get("wall_load"),
+               "wall_sim": envelope.get("wall_sim")}
         records[index] = rec
         with results_path.open("a") as f:
             f.write(json.dumps(rec) + "\n")

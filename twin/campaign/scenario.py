@@ -12,6 +12,9 @@ from .loading import load_object
 from .spec import Campaign, Scenario
 
 UNIT_TO_MAP = {"m": 1000.0, "rad": 180.0 / math.pi}  # SI -> the map's units (mm, deg), as a PLC sees them
+# wall seconds of the last scenario run in this process: loading the station, running the driver (for the
+# benchmark; never part of the results, which must not depend on the wall clock)
+LAST_TIMING: dict[str, float] = {}
 
 
 class ScenarioError(Exception):
@@ -315,8 +318,10 @@ class Context:
         from plc_client.scan import TwinIO
 
         io = TwinIO(self.twin, local=local)
-        if self._link["lost"] or self._link["latency"] or self._link["jitter"]:
-            io = LinkFaults(io, **self._link)
+        watchdog = getattr(self.twin, "watchdog", None)
+        feed = (lambda: watchdog.feed("plc")) if watchdog is not None and watchdog.timeout else None
+        if self._link["lost"] or self._link["latency"] or self._link["jitter"] or feed:
+            io = LinkFaults(io, **self._link, on_exchange=feed)
         return io
 
     def scan(self, logic, cycle: float | None = None, local=None):
@@ -343,12 +348,16 @@ def run_scenario(campaign: Campaign, index: int) -> dict:
 
 
 def _run(campaign: Campaign, scenario: Scenario) -> dict:
+    import time
+
     from twin.core import Twin
     from twin.core.station import load_station
     from twin.faults import FaultInjector, FaultError
     from twin.native_output import quiet_native_output
 
     params = scenario.params
+    LAST_TIMING.clear()
+    t0 = time.perf_counter()
     station = build_station(load_station(campaign.station), params)
     driver = campaign.driver
     if driver.kind == "rapid" and station.controller is None and not driver.ref:
@@ -361,6 +370,12 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
     with quiet_native_output():
         twin = Twin(station)
     try:
+        from twin.cell import add_watchdog
+
+        watchdog = add_watchdog(twin)  # the cell's comm-loss watchdog, as `twin serve` has it
+        if campaign.watchdog is not None:
+            watchdog.timeout = campaign.watchdog
+        watchdog.log = lambda text: None
         if station.controller is not None:
             from rapid_like.station_host import attach_controller
 
@@ -401,6 +416,8 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
         names = sorted(cond_names | set(watch_signals))
         ctx = Context(campaign, scenario, twin, link)
         outcome = {"outcome": "", "fault": "none", "message": ""}
+        t1 = time.perf_counter()
+        LAST_TIMING["load"] = t1 - t0
 
         def verdict() -> bool:
             values = signals.values(names)
@@ -458,6 +475,7 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
                 outcome["outcome"] = "completed"
             if ctx.grip_watch.grips == 0 and ctx.grip_watch.misses == 0:
                 ctx.grip_watch.grips = monitor.gripped_edges
+        LAST_TIMING["sim"] = time.perf_counter() - t1
         gw = ctx.grip_watch
         result = {**outcome, "time": round(twin.time, 9), "steps": twin.step_count,
                   "grips": gw.grips, "misses": gw.misses, "grip": _grip(gw.grips, gw.misses),
@@ -471,6 +489,8 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
                            "part_end_mm": [v * 1000.0 for v in end] if present else None,
                            "part_moved_mm": math.dist(end, part_start) * 1000.0 if present else None})
         result["faults_log"] = [f"{t:.3f} s {text}" for t, text in injector.log]
+        if watchdog.timeout:
+            result["comm_lost_trips"] = watchdog.trips
         for k, v in ctx.measured.items():
             result[f"m.{k}" if k in result else k] = v
         if monitor.record:

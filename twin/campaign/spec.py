@@ -44,7 +44,7 @@ FAULT_KINDS = {  # kind: (required keys, optional keys)
 }
 LINK_KINDS = {"link_lost", "link_latency"}
 EXPECT_KEYS = {"outcome", "fault", "grip", "grips", "misses", "cycle_time_max", "part", "part_at_mm",
-               "part_tolerance_mm", "max_finger_force", "slip", "plc_fault", "values"}
+               "part_tolerance_mm", "part_present", "max_finger_force", "slip", "plc_fault", "values"}
 OUTCOMES = ("completed", "stopped", "timeout", "error")
 GRIP_OUTCOMES = ("confirmed", "missed", "retried", "none")
 DEFAULT_TIMEOUT = 300.0  # s of wall time one scenario may take
@@ -108,6 +108,7 @@ class Campaign:
     when: list  # [(Expression, dict)]
     measure: dict
     scenarios: list[Scenario] = field(default_factory=list)
+    watchdog: float | None = None  # s: the comm-loss watchdog's time (default: the station's [watchdog])
     record: tuple[str, ...] = ()  # signals traced for failing scenarios
 
     def scenario(self, index: int) -> Scenario:
@@ -200,7 +201,8 @@ def load_campaign(path: str | Path) -> Campaign:
     start = flatten(start)
 
     run = _table(file, data, "run")
-    _only(file, "run", run, {"max_time", "done_when", "stop_when", "timeout"})
+    _only(file, "run", run, {"max_time", "done_when", "stop_when", "timeout", "watchdog"})
+    watchdog = _number(file, "run.watchdog", run["watchdog"], positive=True) if "watchdog" in run else None
     max_time = _number(file, "run.max_time", run.get("max_time", DEFAULT_MAX_TIME), positive=True)
     timeout = _number(file, "run.timeout", run.get("timeout", DEFAULT_TIMEOUT), positive=True)
     done_when = _expr(file, "run.done_when", run["done_when"]) if "done_when" in run else None
@@ -236,7 +238,7 @@ def load_campaign(path: str | Path) -> Campaign:
 
     campaign = Campaign(file=file, name=str(name), station=station_path, driver=driver, start=start, max_time=max_time,
                         done_when=done_when, stop_when=stop_when, timeout=timeout, faults=faults, expect=expect,
-                        when=when, measure=measure, record=tuple(record))
+                        when=when, measure=measure, record=tuple(record), watchdog=watchdog)
     base = flatten(_table(file, data, "parameters"))
     for k, v in base.items():
         _check_param(file, f"parameters.{k}", k, v, st, faults, driver)
@@ -386,7 +388,7 @@ def _expectations(file, key, table: dict, st: _Station) -> dict:
                 raise SpecError(file, where, f"must be a whole number >= 0, not {v!r}")
         elif k in ("cycle_time_max", "part_tolerance_mm", "max_finger_force"):
             _number(file, where, v, positive=True)
-        elif k == "slip":
+        elif k in ("slip", "part_present"):
             if not isinstance(v, bool):
                 raise SpecError(file, where, f"must be true or false, not {v!r}")
         elif k == "part":

@@ -63,7 +63,10 @@ def judge(campaign: Campaign, scenario: Scenario, measured: dict) -> tuple[str, 
         s = measured.get("slip")
         if s is not None and bool(s) != exp["slip"]:
             failures.append(f"slip: expected {str(exp['slip']).lower()}, measured {str(bool(s)).lower()}")
-    if "part_tolerance_mm" in exp or "part_at_mm" in exp:
+    if "part_present" in exp and bool(measured.get("part_present")) != exp["part_present"]:
+        failures.append(f"part_present: expected {str(exp['part_present']).lower()}, measured "
+                        f"{str(bool(measured.get('part_present'))).lower()}")
+    if ("part_tolerance_mm" in exp or "part_at_mm" in exp) and exp.get("part_present", True):
         failures += _part(exp, measured)
     for name, want_value in exp.get("values", {}).items():
         failures += _value(name, want_value, measured)

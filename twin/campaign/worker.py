@@ -24,14 +24,15 @@ import rapid_like.station_host  # noqa: E402,F401
 import twin.core  # noqa: E402,F401
 import twin.faults  # noqa: E402,F401
 
-from .scenario import run_scenario  # noqa: E402
+from .scenario import LAST_TIMING, run_scenario  # noqa: E402
 
 
 def execute(campaign, index: int) -> dict:
     """Run one scenario; the envelope: measured values and wall times (s) of the whole and of the run."""
     t0 = time.perf_counter()
     measured = run_scenario(campaign, index)
-    return {"measured": measured, "wall_run": time.perf_counter() - t0}
+    return {"measured": measured, "wall_run": time.perf_counter() - t0, "wall_load": LAST_TIMING.get("load"),
+            "wall_sim": LAST_TIMING.get("sim")}
 
 
 def redirect_output(log_path: str) -> None:

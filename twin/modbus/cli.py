@@ -153,6 +153,8 @@ def _add_profile_arguments(p) -> None:
                         "station by its [profile] table")
     g.add_argument("--map-unit-id", type=_unit, default=MAP_UNIT_ID,
                    help=f"with --profile: the unit id that keeps the generated map and sim.* (default {MAP_UNIT_ID})")
+    p.add_argument("--faults", metavar="FILE", default=None,
+                   help="inject the plant faults of FILE ([faults.NAME] tables as in a campaign: docs/campaigns.md)")
 
 
 def cmd_map(args) -> int:
@@ -229,6 +231,16 @@ def cmd_serve(args) -> int:
             return 2
         announce(f"loading station {args.station}")
         twin = open_twin(args.station, on_event=controller_log)
+        if getattr(args, "faults", None):
+            from twin.campaign.faultfile import load_fault_file
+            from twin.campaign.spec import SpecError
+            from twin.faults import FaultInjector
+
+            try:
+                FaultInjector.attach(twin, load_fault_file(args.faults, twin))
+            except SpecError as exc:
+                _log(f"error: --faults: {exc}", logging.ERROR)
+                return 2
         rmap = build_register_map(twin.signals, twin.station.name)
         profile = None
         if args.profile:
