@@ -201,3 +201,20 @@ def test_the_plc_clients_heartbeat_keeps_a_quiet_plc_alive_and_without_it_the_li
             plc.write(L2=300.0)
             time.sleep(0.8)
         server.wait_for("comm lost")
+
+
+def test_the_robot_program_sees_the_lost_link_on_a_di(tmp_path):
+    from twin.cell import open_cell
+
+    (tmp_path / "watch.mod").write_text('MODULE watch\n  PROC main()\n    WaitDI diCommLost, 1;\n'
+                                        '    TPWrite "link lost";\n  ENDPROC\nENDMODULE\n')
+    path = station(tmp_path, "timeout = 0.05")
+    path.write_text(path.read_text() + '\n[controller]\nprogram = "watch.mod"\nentry = "main"\n\n'
+                    '[[controller.io]]\nname = "diCommLost"\ntype = "DI"\nsource = "comm.lost"\n')
+    said = []
+    with open_cell(path, on_event=lambda e: said.append(e.get("text")) if e.get("type") == "print" else None) as twin:
+        twin.step(10)
+        assert said == [] and not twin.read("diCommLost")
+        twin.watchdog.feed("plc")
+        twin.step(10)
+        assert twin.read("diCommLost") and said == ["link lost"]
