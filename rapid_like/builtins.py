@@ -12,7 +12,7 @@ import math
 from decimal import ROUND_DOWN, ROUND_HALF_UP, Decimal, localcontext
 
 from .nodes import Arg, Param
-from .values import Record, record
+from .values import Opaque, Record, record
 
 # ---- error numbers (ERRNO values) ----------------------------------------------------------------
 ERRORS = {
@@ -32,7 +32,49 @@ ERRORS = {
     "ERR_GO_LIM": 1014,
     "ERR_ARGVALERR": 1015,
     "ERR_NOTPRES": 1016,
+    "ERR_SOCK_TIMEOUT": 1017,
+    "ERR_SOCK_CLOSED": 1018,
+    "ERR_SOCK_ADDR_INUSE": 1019,
+    "ERR_SOCK_NET_UNREACH": 1020,
+    "ERR_ALRDYCNT": 1021,
+    "ERR_CNTNOTVAR": 1022,
+    "ERR_INOMAX": 1023,
+    "ERR_TP_MAXTIME": 1024,
+    "ERR_TP_DIBREAK": 1025,
+    "ERR_TP_DOBREAK": 1026,
+    "ERR_TP_NO_CLIENT": 1027,
+    "ERR_UI_INITVALUE": 1028,
+    "ERR_UI_MAX": 1029,
+    "ERR_UI_MIN": 1030,
+    "ERR_UI_NOTINT": 1031,
+    "ERR_RCVDATA": 1032,
+    "ERR_WHLSEARCH": 1033,
+    "ERR_PATH_STOP": 1034,
+    "ERR_REFUNKDAT": 1035,
+    "ERR_REFUNKPRC": 1036,
+    "ERR_CALLPROC": 1037,
+    "ERR_FILEOPEN": 1038,
+    "ERR_FILEACC": 1039,
+    "ERR_FILNOTFND": 1040,
+    "ERR_NAME_INVALID": 1041,
+    "ERR_OVERFLOW": 1042,
+    "ERR_NUM_LIMIT": 1043,
+    "ERR_INT_NOTVAL": 1044,
+    "ERR_INT_MAXVAL": 1045,
+    "ERR_STRTOVAL": 1046,
+    "ERR_RANYBIN_EOF": 1047,
+    "ERR_PID_MOVESTOP": 1048,
+    "ERR_NOT_MOVETASK": 1049,
+    "ERR_EXECPHR": 1050,
+    "ERR_ARGDUPCND": 1051,
+    "ERR_ARGNAME": 1052,
+    "ERR_AXIS_PAR": 1053,
+    "ERR_TASKNAME": 1054,
+    "ERR_UNKINO": 1055,
+    "ERR_NO_ALIASIO_DEF": 1056,
+    "ERR_NORUNUNIT_WARN": 1057,
 }
+LONG_JMP_ALL_ERR = -1.0  # `ERROR (LONG_JMP_ALL_ERR)`: the handler takes every error raised to it
 ERR_NAMES = {v: k for k, v in ERRORS.items()}
 USER_ERRNO_BASE = 2000  # BookErrNo hands out numbers from here
 
@@ -82,11 +124,47 @@ def predefined_data() -> dict[str, tuple[str, object]]:
     data["pi"] = ("num", math.pi)
     data["high"] = ("dionum", 1.0)
     data["low"] = ("dionum", 0.0)
+    data["edge"] = ("dionum", 2.0)  # ISignalDI/DO: either flank
+    data["long_jmp_all_err"] = ("errnum", LONG_JMP_ALL_ERR)
+    data["wait_max"] = ("num", WAIT_MAX)
+    data["stempty"] = ("string", "")
+    for group in _ENUMS.values():
+        for name, (t, v) in group.items():
+            data[name.lower()] = (t, float(v))
+    data["rob_1"] = ("mecunit", Opaque("mecunit"))
     return data
 
 
-# Predefined *variables* (the USER system module's reg1 to reg5).
-PREDEFINED_VARS: dict[str, str] = {f"reg{i}": "num" for i in range(1, 6)}
+WAIT_MAX = 8388608.0  # "wait forever" for \MaxTime and \Time arguments (the manual's WAIT_MAX)
+SIMULATED_DATE = (2024, 1, 1)  # CDate/CTime/GetTime: the simulated calendar starts here, at midnight, at t = 0
+
+# RAPID's predefined symbolic constants, by the type that holds them (values as this interpreter numbers them).
+_ENUMS: dict[str, dict[str, tuple[str, float]]] = {
+    "socketstatus": {n: ("socketstatus", i) for i, n in enumerate(
+        ("SOCKET_CREATED", "SOCKET_CONNECTED", "SOCKET_BOUND", "SOCKET_LISTENING", "SOCKET_CLOSED"), 1)},
+    "opmode": {"OP_UNDEF": ("symnum", 0), "OP_AUTO": ("symnum", 1), "OP_MAN_PROG": ("symnum", 2),
+               "OP_MAN_TEST": ("symnum", 3)},
+    "runmode": {n: ("symnum", i) for i, n in enumerate(
+        ("RUN_UNDEF", "RUN_CONT_CYCLE", "RUN_INSTR_FWD", "RUN_INSTR_BWD", "RUN_SIM", "RUN_STEP_MOVE"))},
+    "btnres": {n: ("btnres", i) for i, n in enumerate(
+        ("resUnkwn", "resOK", "resAbort", "resRetry", "resIgnore", "resCancel", "resYes", "resNo"))},
+    "buttondata": {"btnNone": ("buttondata", -1), **{n: ("buttondata", i) for i, n in enumerate(
+        ("btnOK", "btnAbrtRtryIgn", "btnOKCancel", "btnRetryCancel", "btnYesNo", "btnYesNoCancel"))}},
+    "icondata": {n: ("icondata", i) for i, n in enumerate(
+        ("iconNone", "iconInfo", "iconWarning", "iconError", "iconQuestion"))},
+    "tpnum": {"TP_LATEST": ("tpnum", 1), "TP_PROGRAM": ("tpnum", 2), "TP_SCREENVIEWER": ("tpnum", 3)},
+    "inttypes": {"USINT": ("num", 1), "UINT": ("num", 2), "UDINT": ("num", 4), "ULINT": ("num", 8),
+                 "SINT": ("num", -1), "INT": ("num", -2), "DINT": ("num", -4), "LINT": ("num", -8)},
+    "errdomain": {n: ("errdomain", i) for i, n in enumerate(
+        ("COMMON_ERR", "OP_STATE", "SYSTEM_ERR", "HARDWARE_ERR", "PROGRAM_ERR", "MOTION_ERR", "OPERATOR_ERR",
+         "IO_COM_ERR", "USER_DEF_ERR", "SYNCHRO_ERR", "PROCESS_ERR", "CFG_ERR"))},
+    "errtype": {"TYPE_ALL": ("errtype", 0), "TYPE_STATE": ("errtype", 1), "TYPE_WARN": ("errtype", 2),
+                "TYPE_ERR": ("errtype", 3)},
+}
+
+
+# Predefined *variables*: the USER system module's reg1 to reg5 and clock1.
+PREDEFINED_VARS: dict[str, str] = {**{f"reg{i}": "num" for i in range(1, 6)}, "clock1": "clock"}
 
 
 # ---- signatures ----------------------------------------------------------------------------------
@@ -120,6 +198,11 @@ def _sig(text: str) -> list[Param]:
 # is not simulated) and \NoEOffs (no external axes).
 _MOVE_OPTS = (r"\switch Conc, \num ID, \num V | num T, \num Z, \stoppointdata Inpos, \wobjdata WObj, "
               r"\loaddata TLoad")
+_TP_BREAK = r"\num MaxTime, \signaldi DIBreak, \signaldo DOBreak, \INOUT errnum BreakFlag"
+_UI_BREAK = (r"\num MaxTime, \signaldi DIBreak, \switch DIPassive, \signaldo DOBreak, \switch DOPassive, "
+             r"\INOUT errnum BreakFlag")
+_FMT = r"\switch Hex | switch Okt | switch Bin | switch Char"
+_RAW = r"\num IntX | switch Float4 | switch Hex1"
 _INSTRUCTIONS = {
     "Incr": "INOUT num Name",
     "Decr": "INOUT num Name",
@@ -149,7 +232,76 @@ _INSTRUCTIONS = {
     "ConfJ": r"\switch On, \switch Off",
     "ConfL": r"\switch On, \switch Off",
     "VelSet": "num Override, num Max",
-    "AccSet": "num Acc, num Ramp",
+    "AccSet": r"num Acc, num Ramp, \num FinePointRamp",
+    "SingArea": r"\switch Wrist | switch Arm | switch LockAxis4 | switch Off",
+    "CirPathMode": r"\switch PathFrame | switch ObjectFrame | switch CirPointOri | switch Wrist45 | switch Wrist46 "
+                   r"| switch Wrist56",
+    "PathResol": "num PathSampleTime",
+    "GripLoad": "loaddata Load",
+    "WorldAccLim": r"\num On | switch Off",
+    "PathAccLim": r"bool AccLim, \num AccMax, bool DecelLim, \num DecelMax",
+    "MoveJDO": r"robtarget ToPoint, \num ID, speeddata Speed, \num T, zonedata Zone, tooldata Tool, \wobjdata WObj, "
+               r"signaldo Signal, num Value, \loaddata TLoad",
+    "MoveLDO": r"robtarget ToPoint, \num ID, speeddata Speed, \num T, zonedata Zone, tooldata Tool, \wobjdata WObj, "
+               r"signaldo Signal, num Value, \loaddata TLoad",
+    "StopMove": r"\switch Quick, \switch AllMotionTasks",
+    "StartMove": r"\switch AllMotionTasks",
+    "StartMoveRetry": "",
+    "StopMoveReset": r"\switch AllMotionTasks",
+    "ClearPath": "",
+    "StorePath": r"\switch KeepSync",
+    "RestoPath": "",
+    "PDispOff": "",
+    "PDispSet": "pose DispFrame",
+    "EOffsOff": "",
+    "ErrWrite": r"\switch W | switch I, string Header, string Reason, \string RL2, \string RL3, \string RL4",
+    "ExitCycle": "",
+    "SkipWarn": "",
+    "TPReadFK": "INOUT num TPAnswer, string TPText, string TPFK1, string TPFK2, string TPFK3, string TPFK4, "
+                "string TPFK5, " + _TP_BREAK,
+    "TPReadNum": "INOUT num TPAnswer, string TPText, " + _TP_BREAK,
+    "TPReadDnum": "INOUT dnum TPAnswer, string TPText, " + _TP_BREAK,
+    "TPShow": "num Window",
+    "UIMsgBox": r"\string Header, string MsgLine1, \string MsgLine2, \string MsgLine3, \string MsgLine4, "
+                r"\string MsgLine5, \num Buttons, \num Icon, \string Image, \INOUT btnres Result, " + _UI_BREAK,
+    "WaitTestAndSet": "INOUT bool Object",
+    "WaitGI": r"signalgi Signal, \switch NotEQ | switch LT | switch GT, num Value, \num MaxTime, "
+              r"\INOUT bool TimeFlag",
+    "WaitGO": r"signalgo Signal, \switch NotEQ | switch LT | switch GT, num Value, \num MaxTime, "
+              r"\INOUT bool TimeFlag",
+    "WaitAI": r"signalai Signal, \switch LT | switch GT, num Value, \num MaxTime, \INOUT num ValueAtTimeout",
+    "WaitAO": r"signalao Signal, \switch LT | switch GT, num Value, \num MaxTime, \INOUT num ValueAtTimeout",
+    "IDelete": "intnum Interrupt",
+    "ISleep": "intnum Interrupt",
+    "IWatch": "intnum Interrupt",
+    "IEnable": "",
+    "IDisable": "",
+    "ISignalDI": r"\switch Single | switch SingleSafe, signaldi Signal, num TriggValue, intnum Interrupt",
+    "ISignalDO": r"\switch Single | switch SingleSafe, signaldo Signal, num TriggValue, intnum Interrupt",
+    "ISignalGI": r"\switch Single | switch SingleSafe, signalgi Signal, intnum Interrupt",
+    "ISignalGO": r"\switch Single | switch SingleSafe, signalgo Signal, intnum Interrupt",
+    "ITimer": r"\switch Single | switch SingleSafe, num Time, intnum Interrupt",
+    "IPers": "INOUT any Name, intnum Interrupt",
+    "IError": r"errdomain ErrorDomain, \num ErrorId, errtype ErrorType, intnum Interrupt",
+    "SocketCreate": r"INOUT socketdev Socket, \switch UDP",
+    "SocketConnect": r"INOUT socketdev Socket, string Address, num Port, \num Time",
+    "SocketBind": "INOUT socketdev Socket, string LocalAddress, num LocalPort",
+    "SocketListen": "INOUT socketdev Socket",
+    "SocketAccept": r"INOUT socketdev Socket, INOUT socketdev ClientSocket, \INOUT string ClientAddress, \num Time",
+    "SocketSend": r"INOUT socketdev Socket, \string Str | rawbytes RawData | byte{} Data, \num NoOfBytes",
+    "SocketReceive": r"INOUT socketdev Socket, \INOUT string Str | INOUT rawbytes RawData | INOUT byte{} Data, "
+                     r"\num ReadNoOfBytes, \INOUT num NoRecBytes, \num Time",
+    "SocketClose": "INOUT socketdev Socket",
+    "ClearRawBytes": r"INOUT rawbytes RawData, \num FromIndex",
+    "PackRawBytes": r"any Value, INOUT rawbytes RawData, \switch Network, num StartIndex, "
+                    r"\num IntX | switch Float4 | switch ASCII | switch Hex1",
+    "UnpackRawBytes": r"rawbytes RawData, \switch Network, num StartIndex, INOUT any Value, "
+                      r"\num IntX | switch Float4 | num ASCII | switch Hex1",
+    "CopyRawBytes": r"rawbytes FromRawData, num FromIndex, INOUT rawbytes ToRawData, num ToIndex, \num NoOfBytes",
+    "BitSet": "INOUT byte BitData, num BitPos",
+    "BitClear": "INOUT byte BitData, num BitPos",
+    "SpyStart": "string File",
+    "SpyStop": "",
     "BookErrNo": "INOUT errnum ErrorName",
     "ClkReset": "INOUT clock Clock",
     "ClkStart": "INOUT clock Clock",
@@ -190,6 +342,62 @@ _FUNCTIONS = {
     "AOutput": ("signalao Signal", "num"),
     "GOutput": ("signalgo Signal", "num"),
     "TestDI": ("signaldi Signal", "bool"),
+    "GInput": ("signalgi Signal", "num"),
+    "AInput": ("signalai Signal", "num"),
+    "StrFind": (r"string Str, num ChPos, string Set, \switch NotInSet", "num"),
+    "StrMatch": ("string Str, num ChPos, string Pattern", "num"),
+    "StrMemb": ("string Str, num ChPos, string Set", "bool"),
+    "StrOrder": ("string Str1, string Str2, string Order", "bool"),
+    "StrMap": ("string Str, string FromMap, string ToMap", "string"),
+    "StrToVal": ("string Str, INOUT any Val", "bool"),
+    "StrToByte": ("string ConStr, " + _FMT, "byte"),
+    "ByteToStr": ("byte BitData, " + _FMT, "string"),
+    "DnumToStr": (r"dnum Val, num Dec, \switch Exp", "string"),
+    "NumToDnum": ("num Value", "dnum"),
+    "DnumToNum": (r"dnum Value, \switch Integer", "num"),
+    "DecToHex": ("string Str", "string"),
+    "HexToDec": ("string Str", "string"),
+    "BitAnd": ("byte BitData1, byte BitData2", "byte"),
+    "BitOr": ("byte BitData1, byte BitData2", "byte"),
+    "BitXOr": ("byte BitData1, byte BitData2", "byte"),
+    "BitNeg": ("byte BitData", "byte"),
+    "BitLSh": ("byte BitData, num ShiftSteps", "byte"),
+    "BitRSh": ("byte BitData, num ShiftSteps", "byte"),
+    "BitCheck": ("byte BitData, num BitPos", "bool"),
+    "GetSysInfo": (r"\switch SerialNo | switch SWVersion | switch RobotType | switch CtrlId | switch LanIp "
+                   r"| switch CtrlLang | switch SystemName", "string"),
+    "GetTime": (r"\switch WDay | switch Hour | switch Min | switch Sec", "num"),
+    "CDate": ("", "string"),
+    "CTime": ("", "string"),
+    "OpMode": ("", "symnum"),
+    "RunMode": (r"\num TaskRef", "symnum"),
+    "IsStopMoveAct": (r"\switch FromMoveTask | switch FromNonMoveTask", "bool"),
+    "GetTaskName": (r"\INOUT num TaskNo, \switch MecTaskNo", "string"),
+    "RobOS": ("", "bool"),
+    "TaskRunRob": ("", "bool"),
+    "TaskRunMec": ("", "bool"),
+    "IsMechUnitActive": ("mecunit MechUnit", "bool"),
+    "CSpeedOverride": (r"\switch CTask", "num"),
+    "MaxRobSpeed": ("", "num"),
+    "PoseMult": ("pose Pose1, pose Pose2", "pose"),
+    "PoseInv": ("pose Pose", "pose"),
+    "PoseVect": ("pose Pose, pos Pos", "pos"),
+    "DefFrame": (r"robtarget OriginP1, robtarget OriginP2, robtarget OriginP3, \num Origin", "pose"),
+    "CPos": (r"\tooldata Tool, \wobjdata WObj", "pos"),
+    "CTool": ("", "tooldata"),
+    "CWObj": ("", "wobjdata"),
+    "VectMagn": ("pos Vector", "num"),
+    "DotProd": ("pos Vector1, pos Vector2", "num"),
+    "NOrient": ("orient Rotation", "orient"),
+    "SocketGetStatus": ("socketdev Socket", "socketstatus"),
+    "RawBytesLen": ("rawbytes RawData", "num"),
+    "TestAndSet": ("INOUT bool Object", "bool"),
+    "UIMessageBox": (r"\string Header, \string Message | string{} MsgArray, \switch Wrap, \num Buttons | "
+                     r"string{} BtnArray, \num DefaultBtn, \num Icon, \string Image, " + _UI_BREAK, "btnres"),
+    "UINumEntry": (r"\string Header, \string Message | string{} MsgArray, \switch Wrap, \num Icon, "
+                   r"\num InitValue, \num MinValue, \num MaxValue, \switch AsInteger, " + _UI_BREAK, "num"),
+    "UIAlphaEntry": (r"\string Header, \string Message | string{} MsgArray, \switch Wrap, \num Icon, "
+                     r"\string InitString, " + _UI_BREAK, "string"),
 }
 FUNCTIONS: dict[str, tuple[list[Param], str]] = {k.lower(): (_sig(s), r) for k, (s, r) in _FUNCTIONS.items()}
 PROPER_NAMES = {k.lower(): k for k in (*_INSTRUCTIONS, *_FUNCTIONS)}  # for messages: `Abs`, not `abs`
@@ -407,3 +615,8 @@ def euler_zyx(axis: str, o: Record) -> float:
 def dist(a: Record, b: Record) -> float:
     fa, fb = a.fields, b.fields
     return math.sqrt(sum((fa[k] - fb[k]) ** 2 for k in ("x", "y", "z")))  # type: ignore[operator]
+
+
+def zone_names() -> set[str]:
+    """The predefined zonedata names (fine, z0 ... z200)."""
+    return set(_zones())

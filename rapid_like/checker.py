@@ -17,11 +17,41 @@ from dataclasses import dataclass
 
 from . import builtins as B
 from . import nodes as n
+from . import rapid_names
 from .errors import CheckError, Span
 from .host import SignalInfo
 from .tokens import KEYWORDS
-from .values import KNOWN_TYPES, RECORDS, SIGNAL_TYPES, a_, array_type, base_type, split_array_type
+from .values import (BUILTIN_RECORDS, KNOWN_TYPES, RECORDS, SIGNAL_TYPES, a_, array_type, base_type, define_records,
+                     split_array_type)
 
+# A name the program uses as a signal without an I/O configuration: its kind from its prefix.
+_SIGNAL_PREFIXES = {"di": "DI", "do": "DO", "ai": "AI", "ao": "AO", "gi": "GI", "go": "GO"}
+
+
+# Instructions accepted whose effect the simulation only approximates (`rapid check` lists each use).
+_APPROXIMATE = {
+    "velset": "the speed override and limit scale the motions' speed data; the robot's own dynamics are not modelled",
+    "accset": "acceleration is scaled in the station's motion only as a duration factor",
+    "confj": "the arm configuration is not checked (the simulated arm has one solution per target)",
+    "confl": "the arm configuration is not checked (the simulated arm has one solution per target)",
+    "singarea": "singularities are not simulated",
+    "pathresol": "the path resolution does not change the simulated motion",
+    "cirpathmode": "the tool orientation along a circle is not changed by CirPathMode",
+    "gripload": "the payload is not simulated",
+    "worldacclim": "acceleration limits are not simulated",
+    "pathacclim": "acceleration limits are not simulated",
+    "stopmove": "motions are not queued: StopMove only holds the next motion until StartMove",
+    "startmove": "motions are not queued: StartMove releases motions held by StopMove",
+    "clearpath": "motions are not queued: there is no path to clear",
+    "storepath": "motions are not queued: StorePath keeps nothing",
+    "restopath": "motions are not queued: RestoPath restores nothing",
+    "pdispset": "program displacement is not applied to the motions",
+    "pdispoff": "program displacement is not applied to the motions",
+    "eoffsoff": "external axes are not simulated",
+    "ierror": "error interrupts never fire in simulation",
+    "spystart": "no spy log is written",
+    "waitrob": "motions end in position, so WaitRob never waits",
+}
 
 # RAPID instructions that are deliberately left out of the subset, with what to do instead.
 _UNSUPPORTED = {
@@ -40,18 +70,31 @@ class Sym:
     optional: bool = False  # an optional parameter (\\Name) of the routine
 
 
-def check(module: n.Module, signals: dict[str, SignalInfo] | None = None) -> None:
-    """Raise CheckError for the first static error in `module`."""
-    Checker(module, signals or {}).run()
+def check(program: n.Module | n.Task, signals: dict[str, SignalInfo] | None = None,
+          infer_signals: bool = False) -> "Checker":
+    """Raise CheckError for the first static error in `program` (a module or a task of modules).
+    With `infer_signals` (no I/O configuration given), a name used as a signal is taken as one:
+    `checker.inferred` lists them and `checker.warnings` says so, with what else is approximate."""
+    c = Checker(program, dict(signals or {}), infer_signals)
+    c.run()
+    return c
+
+
+def as_task(program: n.Module | n.Task) -> n.Task:
+    return program if isinstance(program, n.Task) else n.Task([program])
 
 
 class Checker:
-    def __init__(self, module: n.Module, signals: dict[str, SignalInfo]):
-        self.module = module
+    def __init__(self, program: n.Module | n.Task, signals: dict[str, SignalInfo], infer_signals: bool = False):
+        self.task = as_task(program)
         self.signals = signals
+        self.infer = infer_signals
+        self.inferred: list[SignalInfo] = []
+        self.warnings: list[tuple[Span, str]] = []
         self.globals: dict[str, Sym] = {}
         self.routines: dict[str, n.Routine] = {}
         self.predefined = {k: Sym("data", t, "CONST") for k, (t, _) in B.predefined_data().items()}
+        self.current: n.Routine | None = None
 
     # ---- names ---------------------------------------------------------------------------------
     def err(self, msg: str, span: Span) -> CheckError:
@@ -72,6 +115,11 @@ class Checker:
         return key
 
     def undefined(self, name: str, span: Span, scope: dict[str, Sym], what: str = "") -> CheckError:
+        kind = rapid_names.kind_of(name)
+        if kind == "data":
+            return self.err(f"{name} is RAPID predefined data that rapid_like does not define", span)
+        if kind is not None:
+            return self.err(f"{name} is a RAPID {kind} that rapid_like does not implement", span)
         close = difflib.get_close_matches(name.lower(), self.all_names(scope), n=1)
         hint = ""
         if close:
@@ -93,7 +141,23 @@ class Checker:
             return Sym("data", B.PREDEFINED_VARS[key], "VAR", name=key)
         if key in self.signals:
             return Sym("signal", "num", "CONST", self.signals[key])
+        if self.infer and len(name) > 2 and name[:2].lower() in _SIGNAL_PREFIXES and \
+                (name[2] in "_0123456789" or name[2].isupper() or name[:2].isupper()):
+            info = self.infer_signal(name, _SIGNAL_PREFIXES[name[:2].lower()])
+            return Sym("signal", "num", "CONST", info)
         return None
+
+    def infer_signal(self, name: str, kind: str, span: Span | None = None) -> SignalInfo:
+        info = SignalInfo(name, kind)
+        self.signals[name.lower()] = info
+        self.inferred.append(info)
+        self.warn(span or self.task.span, f"{name} is not a configured I/O signal: taken as {a_(kind)} from its use "
+                                          f"(configure the I/O with --io or in the station)")
+        return info
+
+    def warn(self, span: Span | None, message: str) -> None:
+        if span is not None:
+            self.warnings.append((span, message))
 
     def check_type_name(self, t: str, span: Span, allow_signals: bool = False) -> None:
         if t == "switch":
@@ -118,23 +182,97 @@ class Checker:
 
     # ---- module --------------------------------------------------------------------------------
     def run(self) -> None:
-        for r in self.module.routines:
-            if r.key in self.routines:
-                raise self.err(f"routine {r.name} is declared twice (first on line "
-                               f"{self.routines[r.key].span.line})", r.span)
-            self.routines[r.key] = r
+        self.define_records()
+        # Every module's names first (a module may use what a later one declares), each module seeing
+        # the task's global names and its own LOCAL ones.
+        task_routines: dict[str, n.Routine] = {}
+        task_data: dict[str, tuple[Sym, n.DataDecl]] = {}
+        local_routines: dict[str, dict[str, n.Routine]] = {m.name: {} for m in self.task.modules}
+        local_data: dict[str, dict[str, tuple[Sym, n.DataDecl]]] = {m.name: {} for m in self.task.modules}
+        names = [m.name.lower() for m in self.task.modules]
+        for m in self.task.modules:
+            if names.count(m.name.lower()) > 1 and m.name != "<anonymous>":
+                raise self.err(f"module {m.name} is loaded twice", m.span)
+            for r in m.routines:
+                table = local_routines[m.name] if r.local else task_routines
+                first = table.get(r.key) or local_routines[m.name].get(r.key) or \
+                    (task_routines.get(r.key) if r.local else None)
+                if first is not None and (first.local == r.local or first.module == m.name):
+                    where = f"line {first.span.line}" if first.span.file == r.span.file else str(first.span)
+                    raise self.err(f"routine {r.name} is declared twice (first on {where})", r.span)
+                table[r.key] = r
+            for d in m.data:
+                self.check_type_name(d.type, d.type_span)
+                sym = Sym("data", array_type(d.type, len(d.dims)) if d.dims else d.type, d.storage, name=d.name)
+                table = local_data[m.name] if d.local else task_data
+                first_d = table.get(d.key) or local_data[m.name].get(d.key)
+                if first_d is not None:
+                    where = f"line {first_d[1].span.line}" if first_d[1].span.file == d.span.file else \
+                        str(first_d[1].span)
+                    if d.storage == "PERS" and first_d[1].storage == "PERS" and not d.local and \
+                            first_d[1].module != m.name and first_d[0].type == sym.type:
+                        continue  # a PERS declared in several modules is one persistent
+                    raise self.err(f"{d.name} is declared twice (first on {where})", d.span)
+                if d.key in task_routines or d.key in local_routines[m.name]:
+                    raise self.err(f"{d.name} is declared twice (also a routine)", d.span)
+                if d.key in self.signals:
+                    raise self.err(f"{d.name} is already a configured I/O signal", d.span)
+                table[d.key] = (sym, d)
+        self.routines = dict(task_routines)
+        self.infer_signals_from_calls()
         self.check_signal_names()
-        for d in self.module.data:
-            dtype = self.decl_type(d, {})
-            if d.key in self.globals or d.key in self.routines:
-                raise self.err(f"{d.name} is declared twice", d.span)
-            if d.key in self.signals:
-                raise self.err(f"{d.name} is already a configured I/O signal", d.span)
-            if d.init is not None:
-                self.expect_type(d.init, dtype, {})
-            self.globals[d.key] = Sym("data", dtype, d.storage, name=d.name)
-        for r in self.module.routines:
-            self.routine(r)
+        for m in self.task.modules:
+            self.routines = {**task_routines, **local_routines[m.name]}
+            self.globals = {k: v[0] for k, v in {**task_data, **local_data[m.name]}.items()}
+            for d in m.data:
+                for e in d.dims:
+                    self.expect_type(e, "num", {}, what="an array size")
+                if d.init is not None:
+                    self.expect_type(d.init, self.globals[d.key].type, {})
+            for r in m.routines:
+                self.routine(r)
+        self.routines = dict(task_routines)
+        self.globals = {k: v[0] for k, v in task_data.items()}
+
+    def define_records(self) -> None:
+        seen: dict[str, n.RecordDecl] = {}
+        for rec in self.task.records:
+            if rec.key in BUILTIN_RECORDS or rec.key in KNOWN_TYPES - set(seen) and rec.key not in RECORDS:
+                raise self.err(f"RECORD {rec.name}: {rec.key} is a RAPID data type already", rec.span)
+            if rec.key in seen:
+                raise self.err(f"RECORD {rec.name} is declared twice (first on {seen[rec.key].span})", rec.span)
+            fields = [f.lower() for f, _, _ in rec.fields]
+            for fname, _, fspan in rec.fields:
+                if fields.count(fname.lower()) > 1:
+                    raise self.err(f"RECORD {rec.name} has two components named {fname}", fspan)
+            seen[rec.key] = rec
+        define_records([(rec.key, [(f, t) for f, t, _ in rec.fields]) for rec in self.task.records])
+        for rec in self.task.records:
+            for fname, ftype, fspan in rec.fields:
+                self.check_type_name(ftype, fspan)
+                if ftype == rec.key:
+                    raise self.err(f"RECORD {rec.name} cannot contain itself (component {fname})", fspan)
+
+    def infer_signals_from_calls(self) -> None:
+        """Without an I/O configuration, a name passed where a built-in takes a signal (SetDO x, WaitDI x,
+        DOutput(x), ...) and declared nowhere is a signal of that kind."""
+        if not self.infer:
+            return
+        declared = {d.key for d in self.task.data} | {r.key for r in self.task.routines}
+        for r in self.task.routines:
+            declared |= {q.key for p in r.params for q in (p, *p.alternatives)}
+            declared |= {s.decl.key for s in _walk_stmts(r.body + (r.error_handler or [])) if isinstance(s, n.LocalDecl)}
+        for r in self.task.routines:
+            for name, args, params in _builtin_calls(r):
+                bound, msg, _ = B.match_args(params, args)
+                if msg:
+                    continue
+                table = B.param_table(params)
+                for key, a in bound.items():
+                    kind = SIGNAL_TYPES.get(table[key].type)
+                    if kind and isinstance(a.value, n.Name) and a.value.key not in declared and \
+                            a.value.key not in self.signals and a.value.key not in self.predefined:
+                        self.infer_signal(a.value.name, kind, a.value.span)
 
     def check_signal_names(self) -> None:
         """A configured signal's name must not be taken by anything else the program can name: a
@@ -157,6 +295,8 @@ class Checker:
 
     def routine(self, r: n.Routine) -> None:
         scope: dict[str, Sym] = {}
+        if r.kind == "TRAP" and r.params:
+            raise self.err(f"TRAP {r.name} takes no parameters", r.span)
         if r.return_type:
             self.check_type_name(r.return_type, r.span)
         for p in r.params:
@@ -180,8 +320,12 @@ class Checker:
                 raise self.err(f"label {lab.name} is declared twice in {r.name}", lab.span)
             seen[lab.name.lower()] = lab
         self.block(r.body, scope, in_handler=False)
+        for e in r.error_list or []:
+            self.expect_type(e, "errnum", scope, what="an ERROR list")
         if r.error_handler is not None:
             self.block(r.error_handler, scope, in_handler=True)
+        if r.undo is not None:
+            self.block(r.undo, scope, in_handler=False)
         if r.kind == "FUNC" and not any(isinstance(s, n.Return)
                                         for s in _walk_stmts(r.body + (r.error_handler or []))):
             raise self.err(f"FUNC {r.name} has no RETURN: a function must return its value with "
@@ -224,8 +368,7 @@ class Checker:
             for e in (s.start, s.stop, s.step):
                 if e is not None:
                     self.expect_type(e, "num", scope, what="a FOR bound")
-            if s.var.lower() in scope:
-                raise self.err(f"the FOR variable {s.var} hides a routine variable of the same name", s.var_span)
+            # the loop variable hides data, a parameter or an outer loop variable of the same name in the loop
             inner = dict(scope)
             inner[s.var.lower()] = Sym("loop", "num", "CONST", name=s.var)
             self.block(s.body, inner, h)
@@ -263,6 +406,15 @@ class Checker:
                 raise self.err(f"GOTO {s.label}: " + ("the label is inside another IF, WHILE, FOR or TEST; GOTO "
                                                       "cannot jump into one" if inside else
                                                       f"no label {s.label}: in {self.current.name}"), s.label_span)
+        elif isinstance(s, n.Connect):
+            t = self.assign_target(s.target, scope)
+            if t is not None and base_type(t) != "num":
+                raise self.err(f"CONNECT needs an intnum variable, {s.target.text} is {a_(t)}", s.target.span)
+            r = self.routines.get(s.trap.lower())
+            if r is None:
+                raise self.undefined(s.trap, s.trap_span, scope, " (a TRAP routine)")
+            if r.kind != "TRAP":
+                raise self.err(f"CONNECT ... WITH {r.name}: {r.name} is a {r.kind}, not a TRAP routine", s.trap_span)
         elif isinstance(s, (n.Exit, n.Label)):
             pass
         else:  # pragma: no cover - the parser makes no other statements
@@ -294,11 +446,15 @@ class Checker:
         key = s.key
         if key in self.routines:
             r = self.routines[key]
+            if r.kind == "TRAP":
+                raise self.err(f"{r.name} is a TRAP routine: it runs on an interrupt (CONNECT ... WITH {r.name}), "
+                               f"it cannot be called", s.span)
             if r.kind != "PROC":
                 raise self.err(f"{r.name} is a FUNC: call it in an expression, e.g. x := {r.name}(...);", s.span)
             self.args(s.name, r.params, s.args, s.span, scope)
         elif key in B.INSTRUCTIONS:
             self.args(s.name, B.INSTRUCTIONS[key], s.args, s.span, scope)
+            self.approximations(s)
         elif key in B.FUNCTIONS:
             raise self.err(f"{s.name} is a function: use its value, e.g. x := {s.name}(...);", s.span)
         else:
@@ -307,6 +463,9 @@ class Checker:
                 raise self.err(f"{s.name} is data, not an instruction (did you mean {s.name} := ...;?)", s.span)
             if key in _UNSUPPORTED:
                 raise self.err(f"{s.name} is not supported by rapid_like: {_UNSUPPORTED[key]}", s.span)
+            kind = rapid_names.kind_of(key)
+            if kind is not None:
+                raise self.err(f"{s.name} is a RAPID {kind} that rapid_like does not implement", s.span)
             close = difflib.get_close_matches(key, list(self.routines) + list(B.INSTRUCTIONS), n=1)
             hint = ""
             if close:
@@ -375,11 +534,31 @@ class Checker:
             raise self.err(f"type mismatch: {what}: \\{p.name} takes {a_(p.type)}, {ref.name} is {a_(sym.type)}",
                            ref.span)
 
+    def approximations(self, s: n.ProcCall) -> None:
+        """Warnings for what an instruction asks of the controller that the simulation only approximates."""
+        key = s.key
+        word = B.PROPER_NAMES.get(key, s.name)
+        if key in _APPROXIMATE:
+            self.warn(s.span, f"{word}: {_APPROXIMATE[key]}")
+        if key in ("movej", "movel", "movec", "moveabsj", "movejdo", "moveldo"):
+            zone = next((a for a in s.args if a.value is not None and not a.optional and a.value.text.lower() in
+                         B.zone_names()), None)
+            if any(a.optional and a.key == "conc" for a in s.args):
+                self.warn(s.span, f"{word} \\Conc: the program goes on at once; with a station the motion "
+                                  f"still runs to its end point (no blending)")
+            if zone is not None and zone.value.text.lower() != "fine":
+                self.warn(zone.span, f"{word} with zone {zone.value.text}: the program goes on when the robot "
+                                     f"is within the zone; the corner is not rounded (the path runs through "
+                                     f"the point)")
+
     def signal_arg(self, name: str, p: n.Param, e: n.Expr, scope: dict[str, Sym]) -> None:
         want = SIGNAL_TYPES[p.type]
         if not isinstance(e, n.Name):
             raise self.err(f"{name}: argument {p.name} must be {a_(want)} signal, found {e.text}", e.span)
         sym = self.lookup(e.name, scope)
+        if sym is None and self.infer and not self.routines.get(e.key):
+            self.infer_signal(e.name, want, e.span)
+            sym = self.lookup(e.name, scope)
         if sym is None:
             raise self.undefined(e.name, e.span, scope)
         if sym.kind != "signal" or sym.signal is None:
@@ -551,6 +730,9 @@ class Checker:
             return rtype
         if key in B.INSTRUCTIONS:
             raise self.err(f"{e.name} is an instruction and returns no value", e.span)
+        kind = rapid_names.kind_of(key)
+        if kind is not None:
+            raise self.err(f"{e.name} is a RAPID {kind} that rapid_like does not implement", e.span)
         close = difflib.get_close_matches(key, list(self.routines) + list(B.FUNCTIONS), n=1)
         hint = ""
         if close:
@@ -572,6 +754,60 @@ def _walk_stmts(stmts: list[n.Stmt]):
             for _, body in s.cases:
                 yield from _walk_stmts(body)
             yield from _walk_stmts(s.default or [])
+
+
+def _builtin_calls(r: n.Routine):
+    """(name, args, signature) of every built-in instruction and function call in a routine."""
+    body = r.body + (r.error_handler or []) + (r.undo or [])
+    for s in _walk_stmts(body):
+        if isinstance(s, n.ProcCall) and s.key in B.INSTRUCTIONS:
+            yield s.name, s.args, B.INSTRUCTIONS[s.key]
+        for e in _stmt_exprs(s):
+            for c in _walk_exprs(e):
+                if isinstance(c, n.Call) and c.key in B.FUNCTIONS:
+                    yield c.name, c.args, B.FUNCTIONS[c.key][0]
+
+
+def _stmt_exprs(s: n.Stmt):
+    if isinstance(s, n.ProcCall):
+        return [a.value for a in s.args if a.value is not None]
+    if isinstance(s, n.Assign):
+        return [s.target, s.value]
+    if isinstance(s, n.If):
+        return [c for c, _ in s.branches]
+    if isinstance(s, n.While):
+        return [s.cond]
+    if isinstance(s, n.For):
+        return [e for e in (s.start, s.stop, s.step) if e is not None]
+    if isinstance(s, n.Test):
+        return [s.subject] + [v for vs, _ in s.cases for v in vs]
+    if isinstance(s, n.Return) and s.value is not None:
+        return [s.value]
+    if isinstance(s, n.LocalDecl) and s.decl.init is not None:
+        return [s.decl.init]
+    return []
+
+
+def _walk_exprs(e: n.Expr):
+    yield e
+    if isinstance(e, (n.Component,)):
+        yield from _walk_exprs(e.obj)
+    elif isinstance(e, n.Index):
+        yield from _walk_exprs(e.obj)
+        for i in e.indices:
+            yield from _walk_exprs(i)
+    elif isinstance(e, n.Unary):
+        yield from _walk_exprs(e.operand)
+    elif isinstance(e, n.Binary):
+        yield from _walk_exprs(e.left)
+        yield from _walk_exprs(e.right)
+    elif isinstance(e, n.Aggregate):
+        for i in e.items:
+            yield from _walk_exprs(i)
+    elif isinstance(e, n.Call):
+        for a in e.args:
+            if a.value is not None:
+                yield from _walk_exprs(a.value)
 
 
 def _walk_labels(stmts: list[n.Stmt]):

@@ -1,8 +1,22 @@
 """`rapid`: run or check a RAPID program offline.
 
-    rapid run PROGRAM.mod [--entry NAME] [--io TYPE:NAME,...]... [--set NAME=VALUE[@T]]...
-                          [--max-time T] [--step S] [--loop-budget N] [--trace]
-    rapid check PROGRAM.mod [--io TYPE:NAME,...]...
+    rapid run MODULE... [--task DIR] [--data FILE.sys]... [--entry NAME] [--io TYPE:NAME,...]...
+                        [--set NAME=VALUE[@T]]... [--answer VALUE]... [--cycles N]
+                        [--max-time T] [--step S] [--loop-budget N] [--trace]
+    rapid check MODULE... [--task DIR] [--data FILE.sys]... [--io TYPE:NAME,...]...
+
+A task is every module given (`A.mod B.mod user.sys`), those of `--task DIR` (its .mod, .modx,
+.sys and .prg files) and the `--data` files (modules that declare the station data a program
+expects: tooldata, wobjdata, robtargets). Global data, routines and RECORD types of one module are
+seen by all; LOCAL ones only in their own module. The USER module's clock1, reg1..reg5 and tool0,
+wobj0, load0 are predefined.
+
+Without any --io the I/O configuration is taken from the program: a name used as a signal (SetDO x,
+WaitDI x, DOutput(x), ... or a name starting with di/do/ai/ao/gi/go) is a signal of that kind, and
+`rapid check` says so. `rapid check` lists, as warnings with FILE:LINE, everything the program asks
+for that the simulation only approximates (zones, VelSet, path control, ...).
+`--answer` values answer the FlexPendant dialogs (TPReadFK: the key's number or text; TPReadNum: a
+number; UIMessageBox: a button such as resYes or its number), one per dialog, in order.
 
 `--io` plays the controller's I/O configuration (types DI, DO, AI, AO, GI, GO). Without --trace,
 TPWrite lines go to stdout; with --trace every observable event is one JSON object per line.
@@ -21,7 +35,8 @@ import json
 import sys
 from pathlib import Path
 
-from .controller import DEFAULT_LOOP_BUDGET, read_source
+from . import nodes as n
+from .controller import DEFAULT_LOOP_BUDGET, read_source, task_files
 from .errors import RapidError
 from .host import SIGNAL_KINDS, SignalInfo
 from .offline import DEFAULT_TIME_LIMIT, SignalChange, run_offline
@@ -90,7 +105,11 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a program offline")
     chk = sub.add_parser("check", help="parse and check a program without running it")
     for sp in (run, chk):
-        sp.add_argument("program", help="a RAPID module (.mod)")
+        sp.add_argument("program", nargs="*", help="the task's modules (.mod, .modx, .sys, .prg)")
+        sp.add_argument("--task", metavar="DIR", help="a task directory: every .mod/.modx/.sys/.prg in it")
+        sp.add_argument("--data", action="append", default=[], metavar="FILE.sys",
+                        help="a module of station data the program expects (tooldata, wobjdata, robtargets); "
+                             "repeatable")
         sp.add_argument("--io", action="extend", nargs="+", default=[], metavar="TYPE:NAME,...",
                         help="configure I/O signals, e.g. DI:diGripped,AO:aoAxis1 (repeatable)")
         sp.add_argument("--entry", default="main", help="routine to start from (default: main)")
@@ -106,6 +125,12 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--loop-budget", type=int, default=DEFAULT_LOOP_BUDGET, metavar="N",
                      help="loop iterations that consume no time run per tick before the loop waits for "
                           f"the next tick (default {DEFAULT_LOOP_BUDGET})")
+    run.add_argument("--answer", action="append", default=[], metavar="VALUE",
+                     help="the answer to the next FlexPendant dialog (TPReadFK, TPReadNum, UIMessageBox, ...); "
+                          "repeatable, used in order")
+    run.add_argument("--cycles", type=int, default=1, metavar="N",
+                     help="run the entry routine N times, as continuous mode does; ExitCycle ends a cycle "
+                          "(default 1)")
     run.add_argument("--trace", action="store_true",
                      help="print every event as one JSON object per line; the last line is the end (or "
                           "error) line, after the edges of any PulseDO still running when the program "
@@ -114,27 +139,45 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _program_first(argv: list[str]) -> list[str]:
-    """Put the program right after the sub-command, so `--io A B` lists never swallow it."""
+    """Put the modules right after the sub-command, so `--io A B` lists never swallow them."""
     if len(argv) < 2 or argv[0] not in ("run", "check"):
         return argv
     rest = argv[1:]
+    modules, others = [], []
     for i, a in enumerate(rest):
-        if not a.startswith("-") and a.lower().endswith((".mod", ".modx", ".prg", ".sys")):
-            return [argv[0], a, *rest[:i], *rest[i + 1:]]
-    return argv
+        after_data = i > 0 and rest[i - 1] in ("--data", "--task")
+        if not a.startswith("-") and not after_data and a.lower().endswith((".mod", ".modx", ".prg", ".sys")):
+            modules.append(a)
+        else:
+            others.append(a)
+    return [argv[0], *modules, *others]
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(_program_first(argv))
     out, err = sys.stdout, sys.stderr
-    path = Path(args.program)
+    paths = list(args.program)
+    if args.task:
+        if not Path(args.task).is_dir():
+            print(f"{args.task}: error: --task needs a directory", file=err)
+            return EX_NOINPUT
+        paths += [str(p) for p in task_files(args.task)]
+    paths += args.data
+    if not paths:
+        print("rapid: error: give the program's modules (or --task DIR)", file=err)
+        return EX_USAGE
+    sources: dict[str, str] = {}
+    for p in paths:
+        try:
+            sources[p] = read_source(p)
+        except OSError as e:
+            print(f"{p}: error: cannot read the program: {e.strerror or e}", file=err)
+            return EX_NOINPUT
+    first = paths[0]
     try:
-        source = read_source(path)
-    except OSError as e:
-        print(f"{args.program}: error: cannot read the program: {e.strerror or e}", file=err)
-        return EX_NOINPUT
-    try:
+        if args.command == "run" and args.cycles < 1:
+            raise UsageError("--cycles must be >= 1")
         signals = parse_io(args.io)
         changes = parse_set(args.set, signals) if args.command == "run" else []
         if args.command == "run":
@@ -149,19 +192,24 @@ def main(argv: list[str] | None = None) -> int:
         return EX_USAGE
 
     def report(e: RapidError) -> None:
-        text = e.render(source)
+        text = e.render(sources.get(e.span.file) if e.span else None)
         if e.span is None:
-            text = f"{args.program}: {text}"
+            text = f"{first}: {text}"
         print(text, file=err)
 
+    infer = not args.io
     try:
-        module = parse(source, args.program)
+        program = n.Task([parse(sources[p], p) for p in paths])
+        if len(program.modules) == 1:
+            program = program.modules[0]  # type: ignore[assignment]
         if args.command == "check":
             from .checker import check
             from .controller import Controller
             from .host import InMemoryHost
-            check(module, {s.name.lower(): s for s in signals})
-            Controller(module, InMemoryHost(signals), args.entry, autostart=False)
+            checker = check(program, {s.name.lower(): s for s in signals}, infer_signals=infer)
+            Controller(program, InMemoryHost(signals + checker.inferred), args.entry, autostart=False)
+            for span, message in checker.warnings:
+                print(f"{span.file}:{span.line}:{span.col}: warning: {message}", file=out)
             return EX_OK
 
         def on_event(ev: dict) -> None:
@@ -169,9 +217,12 @@ def main(argv: list[str] | None = None) -> int:
                 out.write(json.dumps(ev) + "\n")
             elif ev["type"] == "print":
                 out.write(ev["text"] + "\n")
+            elif ev["type"] == "errlog":
+                out.write(f"[event log, {ev['level']}] {ev['header']}: {ev['reason']}\n")
 
-        outcome = run_offline(module, signals, changes, args.entry, args.max_time, args.step, on_event,
-                              loop_budget=args.loop_budget)
+        outcome = run_offline(program, signals, changes, args.entry, args.max_time, args.step, on_event,
+                              loop_budget=args.loop_budget, answers=args.answer, cycles=args.cycles,
+                              infer_signals=infer)
     except RapidError as e:
         report(e)
         return EX_DATAERR

@@ -41,7 +41,7 @@ from . import nodes as n
 from .checker import check
 from .errors import CheckError, ExecError, RapidError
 from .host import Host
-from .interpreter import NS, ExitSignal, Fatal, Interpreter, Propagate, Wait, to_ns
+from .interpreter import NS, ExitCycleSignal, ExitSignal, Fatal, Interpreter, Propagate, Wait, to_ns
 from .parser import parse
 from .runtime import DEFAULT_LOOP_BUDGET  # time-less loop iterations per tick
 
@@ -62,10 +62,27 @@ def load_program(path: str | Path) -> n.Module:
     return parse(read_source(path), str(path))
 
 
+TASK_SUFFIXES = (".mod", ".modx", ".sys", ".prg")
+
+
+def task_files(directory: str | Path) -> list[Path]:
+    """The module files of a task directory (every .mod, .modx, .sys and .prg in it, and in its
+    PROGMOD and SYSMOD folders as a RobotStudio backup lays them out), system modules first."""
+    root = Path(directory)
+    files = [p for p in sorted(root.rglob("*")) if p.is_file() and p.suffix.lower() in TASK_SUFFIXES]
+    return sorted(files, key=lambda p: (p.suffix.lower() != ".sys", str(p)))
+
+
+def load_task(paths: list[str | Path]) -> n.Task:
+    """Read and parse the modules of one task (raises LexError/ParseError)."""
+    return n.Task([load_program(p) for p in paths])
+
+
 class Controller:
-    def __init__(self, program: n.Module, host: Host, entry: str = "main",
+    def __init__(self, program: n.Module | n.Task, host: Host, entry: str = "main",
                  on_event: Callable[[dict], None] | None = None, step: float | None = None,
-                 autostart: bool = True, loop_budget: int = DEFAULT_LOOP_BUDGET):
+                 autostart: bool = True, loop_budget: int = DEFAULT_LOOP_BUDGET,
+                 answers: list[str] | None = None, cycles: int = 1, infer_signals: bool = False):
         """`loop_budget`: how many loop iterations that consume no time the program may run in one
         tick before it hands control back (until the next tick). `step`: for event-driven runners,
         the time of the next tick after a loop used up its budget (`next_wake_ns` reports it); the
@@ -76,15 +93,17 @@ class Controller:
         self.on_event = on_event
         self.step_ns = to_ns(step) if step else None
         signals = {s.name.lower(): s for s in host.signals()}
-        check(program, signals)
-        routine = next((r for r in program.routines if r.key == entry.lower()), None)
+        self.checker = check(program, signals, infer_signals=infer_signals)
+        routine = next((r for r in program.routines if r.key == entry.lower() and not r.local), None)
         if routine is None:
             names = ", ".join(r.name for r in program.routines) or "none"
             raise CheckError(f"no routine named '{entry}' to start from (routines: {names})", None)
-        if routine.kind != "PROC" or any(not p.optional for p in routine.params):
+        if routine.kind != "PROC" or any(not p.optional for p in routine.params):  # (a TRAP is no entry either)
             raise CheckError(f"the entry routine {routine.name} must be a PROC without parameters", routine.span)
         self.entry = routine.name
-        self.interp = Interpreter(program, host, self._emit, loop_budget=loop_budget)
+        self.interp = Interpreter(program, host, self._emit, loop_budget=loop_budget, answers=answers)
+        self.cycles = max(1, int(cycles))  # ExitCycle, or the entry routine's end, starts the next cycle
+        self.cycle = 0
         self.now = 0
         self.state = STOPPED
         self.end_reason: str | None = None
@@ -104,6 +123,7 @@ class Controller:
         self.state, self.end_reason, self.error, self.wait = RUNNING, None, None, None
         self._ended_reported = False
         self._gen = None
+        self.cycle = 0
 
     def stop(self) -> None:
         """Halt the program where it is (resume() continues, start() restarts)."""
@@ -139,6 +159,9 @@ class Controller:
         """The earliest time the program or a pulse needs a tick, or None (only a signal change can
         wake it)."""
         times = [p[0] for p in self.interp.pulses]
+        due = self.interp.interrupts.next_due()
+        if due is not None and self.state in (RUNNING, WAITING):
+            times.append(due)
         if self.state == RUNNING:
             times.append(self.now)
         elif self.state == WAITING and self.wait is not None and self.wait.at is not None:
@@ -151,7 +174,9 @@ class Controller:
             self.on_event({"t": round(self.now / NS, 6), **event})
 
     def _ready(self, w: Wait) -> bool:
-        if w.kind in ("time", "poll"):
+        if self.interp.interrupts.pending and w.kind != "stop":
+            return True  # a TRAP runs while the program waits
+        if w.kind in ("time", "poll", "io"):
             return self.now >= (w.at or 0)
         if w.kind == "step":
             return True  # a loop that used up its budget goes on at the next tick, whenever it comes
@@ -165,6 +190,7 @@ class Controller:
                 self.interp.init_data(keep_pers=self._started)
                 self._started = True
                 self._gen = self.interp.run(self.entry)
+            self.interp.interrupts.poll()
             if self.wait is not None and not self._ready(self.wait):
                 self.state = WAITING
                 self.interp.suspensions += 1
@@ -179,13 +205,19 @@ class Controller:
                 if w.kind == "stop":
                     self.state, self.end_reason = STOPPED, "stop"
                     return
-                if w.kind in ("time", "poll") and self._ready(w):
+                if w.kind in ("time", "poll", "io") and self._ready(w):
                     continue
                 self.state = WAITING
                 self.interp.suspensions += 1
                 return
         except StopIteration:
+            if self._next_cycle():
+                return
             self.state, self.end_reason = COMPLETED, "completed"
+        except ExitCycleSignal:
+            if self._next_cycle():
+                return
+            self.state, self.end_reason = COMPLETED, "exit_cycle"
         except ExitSignal:
             self.state, self.end_reason = COMPLETED, "exit"
         except (Fatal, Propagate) as e:
@@ -195,6 +227,18 @@ class Controller:
         except RecursionError:
             self._fail(ExecError("routine calls nested too deeply (endless recursion?)", None, 0))
         self._gen = None if self.state == ERROR else self._gen
+        if self.state in (COMPLETED, ERROR):
+            self.interp.close_sockets()
+
+    def _next_cycle(self) -> bool:
+        """Start the entry routine again (data keep their values) when cycles remain."""
+        self.cycle += 1
+        if self.cycle >= self.cycles:
+            return False
+        self._gen = self.interp.run(self.entry)
+        self.wait = Wait("step", self.now + (self.step_ns or 0), "the next cycle")
+        self.state = WAITING
+        return True
 
     def _fail(self, err: ExecError) -> None:
         self.state, self.error, self.wait = ERROR, err, None

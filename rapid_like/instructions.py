@@ -40,6 +40,8 @@ class InstructionsMixin:
                 return True
             if ptype in SIGNAL_TYPES:
                 return self.signal_arg(a.value, f, SIGNAL_TYPES[ptype])
+            if ptable[name].mode == "INOUT":
+                return self.lvalue(a.value, f)  # type: ignore[arg-type]
             if ptype == "any":
                 return self.eval(a.value, f)  # type: ignore[arg-type]
             return self.coerce(self.eval(a.value, f), ptype, a.value.span)  # type: ignore[union-attr]
@@ -58,6 +60,12 @@ class InstructionsMixin:
             return float(self.host.read_signal(arg("signal").name))  # type: ignore[union-attr]
         if key == "testdi":
             return self.host.read_signal(arg("signal").name) == 1  # type: ignore[union-attr]
+        impl = getattr(self, "f_" + key, None)
+        if impl is not None:
+            try:
+                return impl(e, arg, bound)
+            except (ValueError, OverflowError) as exc:
+                raise self.fail(f"{e.name}: {exc}", e.span, "ERR_ARGVALERR") from None
         vals = [arg(k) for k in names]
         x = vals[0] if vals else None
         try:
@@ -280,7 +288,7 @@ class InstructionsMixin:
         yield from ()
 
     def i_stop(self, s, arg, text, bound):
-        yield Wait("stop", what="Stop")
+        yield from self.pause(Wait("stop", what="Stop"))
 
     i_break = i_stop
 
@@ -289,7 +297,32 @@ class InstructionsMixin:
             arg(k)  # evaluate for errors
         yield from ()
 
-    i_confj = i_confl = i_velset = i_accset = i_waitrob = _noop
+    i_confj = i_confl = i_accset = _noop
+
+    def i_velset(self, s, arg, text, bound):
+        """VelSet: later motions run at Override % of their programmed speed, at most Max mm/s."""
+        override, vmax = arg("override"), arg("max")
+        if override <= 0 or vmax <= 0:
+            raise self.fail("VelSet: Override and Max must be > 0", s.span, "ERR_ARGVALERR")
+        self.velset = (override, vmax)
+        yield from ()
+
+    def i_waitrob(self, s, arg, text, bound):
+        """WaitRob: wait until a \\Conc motion still running has ended."""
+        for k in bound:
+            arg(k)
+        handle = getattr(self, "concurrent", None)
+        while handle is not None and not self.host.motion_done(handle):
+            yield from self.pause(Wait("motion", None, "WaitRob", s.span))
+        self.concurrent = None
+
+    def i_movejdo(self, s, arg, text, bound):
+        yield from self._move(s, arg, text, bound, "MoveJ")
+        self.write(arg("signal"), 0.0 if arg("value") == 0 else 1.0)
+
+    def i_moveldo(self, s, arg, text, bound):
+        yield from self._move(s, arg, text, bound, "MoveL")
+        self.write(arg("signal"), 0.0 if arg("value") == 0 else 1.0)
 
     def i_waittime(self, s, arg, text, bound):
         t = arg("time")
@@ -298,7 +331,7 @@ class InstructionsMixin:
                             "ERR_ARGVALERR")
         until = self.now + to_ns(t)
         while self.now < until:
-            yield Wait("time", until, f"WaitTime {fmt_num(t)}", s.span)
+            yield from self.pause(Wait("time", until, f"WaitTime {fmt_num(t)}", s.span))
 
     def _wait_cond(self, s, arg, bound, test: Callable[[], bool], name: str, poll: int | None):
         maxtime = arg("maxtime")
@@ -325,9 +358,9 @@ class InstructionsMixin:
                     at = start + k * poll
                 if deadline is not None:
                     at = min(at, deadline)
-                yield Wait("poll", at, name, s.span)
+                yield from self.pause(Wait("poll", at, name, s.span))
             else:
-                yield Wait("signal", deadline, name, s.span)
+                yield from self.pause(Wait("signal", deadline, name, s.span))
 
     def i_waituntil(self, s, arg, text, bound):
         cond = bound["cond"].value
@@ -351,11 +384,18 @@ class InstructionsMixin:
         via = arg("cirpoint") if instr == "MoveC" else None
         speed = arg("speed")
         for k in ("id", "t", "z", "inpos", "tload"):  # accepted and ignored (builtins._MOVE_OPTS), but evaluated
-            arg(k)
-        v = arg("v")
+            if k in B.INSTRUCTION_PARAMS[s.key]:
+                arg(k)
+        v = arg("v") if "v" in B.INSTRUCTION_PARAMS[s.key] else None
         if v is not None:  # \V: the TCP speed in mm/s, instead of the speeddata's v_tcp
             speed = speed.copy()
             speed.fields["v_tcp"] = v
+        velset = getattr(self, "velset", None)
+        if velset is not None and velset != (100.0, 5000.0):  # VelSet: override % and a limit in mm/s
+            speed = speed.copy()
+            speed.fields["v_tcp"] = min(speed.fields["v_tcp"] * velset[0] / 100.0, velset[1])
+        while self.stop_move:  # StopMove holds the motion until StartMove (from a TRAP)
+            yield from self.pause(Wait("signal", None, f"{instr} held by StopMove", s.span))
         req = MotionRequest(
             instr=instr, target=target, via=via, speed=speed, zone=arg("zone"), tool=arg("tool"),
             wobj=arg("wobj", self.predefined["wobj0"].value), target_name=text(target_key),
@@ -367,8 +407,13 @@ class InstructionsMixin:
         ev.update(speed=req.speed_name, zone=req.zone_name, tool=req.tool_name, wobj=req.wobj_name)
         self.emit(ev)
         handle = self.host.start_motion(req)
+        self.active_tool, self.active_wobj = req.tool, req.wobj
+        if arg("conc"):  # \Conc: the program goes on at once, the motion runs on
+            self.concurrent = handle
+            return
+        self.concurrent = None
         while not self.host.motion_done(handle):
-            yield Wait("motion", None, f"{instr} {req.target_name}", s.span)
+            yield from self.pause(Wait("motion", None, f"{instr} {req.target_name}", s.span))
 
     def i_movej(self, s, arg, text, bound):
         yield from self._move(s, arg, text, bound, "MoveJ")

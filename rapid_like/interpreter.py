@@ -28,29 +28,45 @@ from . import nodes as n
 from .errors import ExecError, Span
 from .host import Host, SignalInfo
 from .instructions import InstructionsMixin
-from .runtime import (ABSENT, DEFAULT_LOOP_BUDGET, NS, Cell, ExitSignal, Fatal, Frame, GotoSignal, Propagate, Ref,
-                      RetrySignal, ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
+from .interrupts import InterruptTable
+from .sockets import SocketsMixin
+from .system import SystemMixin
+from .runtime import (ABSENT, DEFAULT_LOOP_BUDGET, NS, Cell, ExitCycleSignal, ExitSignal, Fatal, Frame, GotoSignal,
+                      Propagate, Ref, RetrySignal, ReturnSignal, TryNextSignal, Wait, component_type, to_ns)
 from .values import (SIGNAL_KINDS, SIGNAL_TYPES, STRING_MAX, Aggregate, Array, Record, SignalRef, TypeMismatch, a_, array_type,
                      coerce, default_value, describe_type, fmt_num, json_num, new_array, pos, xyz)
 
 GO_MAX = 2.0 ** 32 - 1  # the largest value of a 32-bit group output
 
-__all__ = ["Interpreter", "Wait", "NS", "to_ns", "ExitSignal", "Fatal", "Propagate"]
+__all__ = ["Interpreter", "Wait", "NS", "to_ns", "ExitSignal", "ExitCycleSignal", "Fatal", "Propagate"]
 
 
-class Interpreter(InstructionsMixin):
+class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
     """Runs one module against a host; the Controller drives `run()` and sets `now` before each resume."""
 
-    def __init__(self, module: n.Module, host: Host, emit: Callable[[dict], None] | None = None,
-                 loop_budget: int = DEFAULT_LOOP_BUDGET):
-        self.module = module
+    def __init__(self, program: n.Module | n.Task, host: Host, emit: Callable[[dict], None] | None = None,
+                 loop_budget: int = DEFAULT_LOOP_BUDGET, answers: list[str] | None = None):
+        self.task = program if isinstance(program, n.Task) else n.Task([program])
+        self.module = self.task.modules[0]
         self.host = host
         self._sink = emit or (lambda ev: None)
         self.signals: dict[str, SignalInfo] = {s.name.lower(): s for s in host.signals()}
         self.signal_cells = {k: Cell(SIGNAL_KINDS[s.kind], SignalRef(s.name, s.kind), "CONST", s.name)
                              for k, s in self.signals.items()}
-        self.routines = {r.key: r for r in module.routines}
+        # routines as each module sees them: the task's global ones and its own LOCAL ones
+        glob = {r.key: r for r in self.task.routines if not r.local}
+        self.routine_scopes = {m.name: {**glob, **{r.key: r for r in m.routines if r.local}}
+                               for m in self.task.modules}
+        self.routines = glob
+        self.scopes: dict[str, dict[str, Cell]] = {m.name: {} for m in self.task.modules}
+        self.answers = list(answers or [])  # --answer values for FlexPendant dialogs, in order
+        self.interrupts = InterruptTable(self)
+        self.sockets: list = []
+        self.stop_move = False
+        self.concurrent = None  # the handle of a \\Conc motion still running
         self.predefined = {k: Cell(t, v, "CONST", k) for k, (t, v) in B.predefined_data().items()}
+        self.active_tool = self.predefined["tool0"].value
+        self.active_wobj = self.predefined["wobj0"].value
         self.globals: dict[str, Cell] = {}
         self.predefined_vars: dict[str, Cell] = {}
         self.now = 0  # ns, set by the controller before every resume
@@ -68,16 +84,44 @@ class Interpreter(InstructionsMixin):
 
     # ---- set-up ---------------------------------------------------------------------------------
     def init_data(self, keep_pers: bool = False) -> None:
-        """(Re)initialise module data. PERS data keep their values when `keep_pers`."""
+        """(Re)initialise module data. PERS data keep their values when `keep_pers`. A declaration may use
+        constants of a module loaded after its own, so declarations whose initial value names data not
+        made yet wait for a later round."""
         old = self.globals
+        old_scopes = self.scopes
         self.globals = {}
+        self.scopes = {m.name: {} for m in self.task.modules}
         self.predefined_vars = {k: Cell(t, default_value(t), "VAR", k) for k, t in B.PREDEFINED_VARS.items()}
-        top = Frame(n.Routine(self.module.span, "PROC", "<module>", [], []))
-        for d in self.module.data:
-            if keep_pers and d.storage == "PERS" and d.key in old:
-                self.globals[d.key] = old[d.key]
-                continue
-            self.globals[d.key] = self.declare(d, top)
+        pending = [(m, d) for m in self.task.modules for d in m.data]
+        while pending:
+            later = []
+            failure = None
+            for m, d in pending:
+                scope = self.scopes[m.name]
+                if d.storage == "PERS" and not d.local and d.key in self.globals:
+                    scope[d.key] = self.globals[d.key]  # a PERS declared in several modules is one persistent
+                    continue
+                previous = (old_scopes.get(m.name) or {}).get(d.key) if d.local else old.get(d.key)
+                if keep_pers and d.storage == "PERS" and previous is not None:
+                    cell = previous
+                else:
+                    top = Frame(n.Routine(m.span, "PROC", "<module>", [], [], module=m.name))
+                    try:
+                        cell = self.declare(d, top)
+                    except ExecError as err:
+                        if err.errname != "ERR_REFUNKDAT":
+                            raise
+                        later.append((m, d))
+                        failure = failure or err
+                        continue
+                scope[d.key] = cell
+                if not d.local:
+                    self.globals[d.key] = cell
+                    for other in self.task.modules:
+                        self.scopes[other.name].setdefault(d.key, cell)
+            if len(later) == len(pending):
+                raise failure  # type: ignore[misc]
+            pending = later
 
     def declare(self, d: n.DataDecl, f: Frame) -> Cell:
         """A new cell for a declaration, with its initial value (arrays get their declared sizes)."""
@@ -104,6 +148,17 @@ class Interpreter(InstructionsMixin):
     def run(self, entry: str) -> Generator[Wait, None, None]:
         r = self.routines[entry.lower()]
         yield from self.invoke(r, Frame(r))
+
+    def routine_for(self, key: str, f: Frame) -> n.Routine | None:
+        """The routine `key` as the module of the running routine sees it."""
+        scope = self.routine_scopes.get(f.routine.module)
+        return (scope or self.routines).get(key)
+
+    def pause(self, w: Wait, f: Frame | None = None):
+        """Yield a wait; when resumed, run the TRAP routines of the interrupts that came meanwhile."""
+        yield w
+        if self.interrupts.pending:
+            yield from self.interrupts.service()
 
     # ---- helpers --------------------------------------------------------------------------------
     def fail(self, message: str, span: Span | None, errname: str = "") -> ExecError:
@@ -132,6 +187,7 @@ class Interpreter(InstructionsMixin):
             raise self.fail(f"SetAO {sig.name}: {fmt_num(value)} is not a finite value", span, "ERR_AO_LIM")
         self.host.write_signal(sig.name, float(value))
         self.emit({"type": sig.kind, "signal": sig.name, "value": json_num(float(value))})
+        self.interrupts.poll()
 
     def apply_pulses(self) -> None:
         """Write the pulse edges that are due (called by the controller at the start of a tick)."""
@@ -165,13 +221,21 @@ class Interpreter(InstructionsMixin):
 
     # ---- routines -------------------------------------------------------------------------------
     def invoke(self, r: n.Routine, frame: Frame):
-        """Run a routine body; an error it does not handle is raised again at the call."""
+        """Run a routine body; an error it does not handle is raised again at the call. When the
+        routine is left by an error raised on to its caller, ExitCycle or EXIT, its UNDO runs first."""
         try:
             yield from self.block(r.body, frame)
         except ReturnSignal as rs:
             return rs.value
         except Propagate as p:
+            yield from self.undo(r, frame)
             raise p.error from None
+        except ExecError:
+            yield from self.undo(r, frame)
+            raise
+        except (ExitCycleSignal, ExitSignal, Fatal):
+            yield from self.undo(r, frame)
+            raise
         if r.kind == "FUNC":  # reached its ENDFUNC: the error is there, where the RETURN is missing
             raise self.fail(f"FUNC {r.name} reached ENDFUNC without RETURN", r.end_span or r.span, "ERR_FNCNORET")
         return None
@@ -209,9 +273,18 @@ class Interpreter(InstructionsMixin):
                     frame.vars[q.key] = Cell(q.type, self.coerce(self.eval(a.value, f), q.type, a.value.span),
                                              "VAR", q.name)
 
+    def undo(self, r: n.Routine, frame: Frame):
+        if r.undo is None or frame.undoing:
+            return
+        frame.undoing = True
+        try:
+            yield from self.block(r.undo, frame)
+        except ReturnSignal:
+            pass
+
     def call_function(self, e: n.Call, f: Frame) -> object:
         key = e.key
-        r = self.routines.get(key)
+        r = self.routine_for(key, f)
         if r is not None:
             frame = Frame(r)
             self.bind(r.name, r.params, e.args, f, e.span, frame)
@@ -232,6 +305,8 @@ class Interpreter(InstructionsMixin):
         i = 0
         mark = self.suspensions
         while i < len(stmts):
+            if self.interrupts.pending:
+                yield from self.interrupts.service()
             if type(stmts[i]) is n.Label:  # a backward GOTO's loop turn starts at its label
                 mark = self.suspensions
             try:
@@ -259,7 +334,7 @@ class Interpreter(InstructionsMixin):
                     err.span = s.span
                 if f.in_handler:
                     raise Fatal(err) from None
-                if f.routine.error_handler is None:
+                if f.routine.error_handler is None or not self.handles(f, err):
                     raise Propagate(err) from None
                 action = yield from self.handler(f, err)
                 if action == "trynext":
@@ -268,6 +343,17 @@ class Interpreter(InstructionsMixin):
                     # RETRY is immediate, but a retry without time passing is a loop iteration
                     # like any other: it uses the loop budget, so a RETRY loop cannot hang the cell.
                     yield from self.spin("RETRY", s.span)
+
+    def handles(self, f: Frame, err: ExecError) -> bool:
+        """Does the routine's ERROR handler take this error? `ERROR (ERR_A, ERR_B)` takes only those
+        (LONG_JMP_ALL_ERR: every error raised to it); a handler without a list takes every error."""
+        if f.routine.error_list is None:
+            return True
+        for e in f.routine.error_list:
+            no = self.num(e, f)
+            if no == B.LONG_JMP_ALL_ERR or int(no) == err.errno:
+                return True
+        return False
 
     def handler(self, f: Frame, err: ExecError):
         self.errno = float(err.errno)
@@ -333,6 +419,11 @@ class Interpreter(InstructionsMixin):
             raise ReturnSignal(value)
         elif isinstance(s, n.Exit):
             raise ExitSignal()
+        elif isinstance(s, n.Connect):
+            ref = self.lvalue(s.target, f)
+            trap = self.routine_for(s.trap.lower(), f)
+            self.interrupts.connect(ref, trap, s.span)  # type: ignore[arg-type]
+            self.changes += 1
         elif isinstance(s, n.Goto):
             raise GotoSignal(s.label.lower())
         elif isinstance(s, n.Retry):
@@ -358,6 +449,7 @@ class Interpreter(InstructionsMixin):
             raise self.fail("FOR loop STEP is 0", s.step.span if s.step else s.span)
         key = s.var.lower()
         cell = Cell("num", start, "CONST", s.var)
+        hidden = f.vars.get(key)  # a routine variable or parameter of the same name, hidden in the loop
         f.vars[key] = cell
         try:
             i = start
@@ -370,7 +462,10 @@ class Interpreter(InstructionsMixin):
                     yield from self.spin("FOR", s.span)
                 i += step
         finally:
-            f.vars.pop(key, None)
+            if hidden is not None:
+                f.vars[key] = hidden
+            else:
+                f.vars.pop(key, None)
 
     # ---- expressions ----------------------------------------------------------------------------
     def truth(self, e: n.Expr, f: Frame) -> bool:
@@ -389,6 +484,9 @@ class Interpreter(InstructionsMixin):
         key = name.lower()
         if key in f.vars:
             return f.vars[key]
+        scope = self.scopes.get(f.routine.module)
+        if scope is not None and key in scope:
+            return scope[key]
         if key in self.globals:
             return self.globals[key]
         if key in self.predefined:
@@ -399,7 +497,7 @@ class Interpreter(InstructionsMixin):
             return self.signal_cells[key]
         if key == "errno":
             return Cell("errnum", self.errno, "CONST", "ERRNO")
-        raise self.fail(f"undefined name '{name}'", span)
+        raise self.fail(f"undefined name '{name}'", span, "ERR_REFUNKDAT")
 
     def eval(self, e: n.Expr, f: Frame) -> object:
         t = type(e)  # the node classes have no subclasses: `type(e) is` is an exact, fast test
@@ -571,7 +669,7 @@ class Interpreter(InstructionsMixin):
         return v
 
     def proc_call(self, s: n.ProcCall, f: Frame):
-        r = self.routines.get(s.key)
+        r = self.routine_for(s.key, f)
         if r is not None:
             frame = Frame(r)
             self.bind(r.name, r.params, s.args, f, s.span, frame)

@@ -1,7 +1,7 @@
 """Lexer: RAPID source text to a list of tokens, each with its line and column.
 
 `!` starts a comment that runs to the end of the line. Strings are double-quoted; a quote inside a
-string is written twice (`""`) and a backslash as `\\\\`; a string literal holds at most 80
+string is written twice (`""`), a backslash as `\\\\` and a character by its hex code as `\\0A`; a string literal holds at most 80
 characters, as every RAPID string does. Numbers are decimal, with an optional fraction and
 exponent (`9E9`, `1.5e-3`); `1.2.3` is a malformed number. An old-style
 `%%% VERSION:1 LANGUAGE:ENGLISH %%%` header at the top of a file is skipped.
@@ -97,6 +97,10 @@ def lex(source: str, file: str = "<input>") -> list[Token]:
                 if c == "\\" and i + 1 < n and source[i + 1] == "\\":
                     chars.append("\\")
                     i += 2
+                    continue
+                if c == "\\" and i + 2 < n and all(h in "0123456789abcdefABCDEF" for h in source[i + 1:i + 3]):
+                    chars.append(chr(int(source[i + 1:i + 3], 16)))  # `\0A`: a character by its code
+                    i += 3
                     continue
                 chars.append(c)
                 i += 1

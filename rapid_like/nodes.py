@@ -200,6 +200,15 @@ class Label(Stmt):
 
 
 @dataclass
+class Connect(Stmt):
+    """`CONNECT intno WITH trap;`: an interrupt number is tied to a TRAP routine."""
+
+    target: Expr
+    trap: str
+    trap_span: Span
+
+
+@dataclass
 class LocalDecl(Stmt):
     """A data declaration inside a routine; it is (re)initialised each time execution reaches it."""
 
@@ -217,6 +226,7 @@ class DataDecl:
     init: Expr | None = None
     local: bool = False
     dims: list[Expr] = field(default_factory=list)  # array sizes, e.g. {3} or {2, 3}
+    module: str = ""  # the module that declares it (module data only)
 
     @property
     def key(self) -> str:
@@ -240,14 +250,32 @@ class Param:
 @dataclass
 class Routine:
     span: Span
-    kind: str  # PROC or FUNC
+    kind: str  # PROC, FUNC or TRAP
     name: str
     params: list[Param]
     body: list[Stmt]
     error_handler: list[Stmt] | None = None
     return_type: str | None = None
     local: bool = False
-    end_span: Span | None = None  # its ENDPROC / ENDFUNC
+    end_span: Span | None = None  # its ENDPROC / ENDFUNC / ENDTRAP
+    error_list: list[Expr] | None = None  # `ERROR (ERR_A, ERR_B)`: the handler takes only these
+    undo: list[Stmt] | None = None  # the UNDO section
+    module: str = ""  # the module that declares it
+
+    @property
+    def key(self) -> str:
+        return self.name.lower()
+
+
+@dataclass
+class RecordDecl:
+    """`RECORD name  type comp; ...  ENDRECORD`: a user-defined record type."""
+
+    span: Span
+    name: str
+    fields: list[tuple[str, str, Span]]  # (component name, lower-case type, span)
+    local: bool = False
+    module: str = ""
 
     @property
     def key(self) -> str:
@@ -262,3 +290,29 @@ class Module:
     routines: list[Routine]
     file: str = "<input>"
     source: str = ""
+    records: list[RecordDecl] = field(default_factory=list)
+    attributes: list[str] = field(default_factory=list)  # SYSMODULE, NOSTEPIN, ...
+
+
+@dataclass
+class Task:
+    """The modules of one RAPID task, loaded together: global data, routines and record types of
+    one module are seen by the others; LOCAL ones only in their own module."""
+
+    modules: list[Module]
+
+    @property
+    def routines(self) -> list[Routine]:
+        return [r for m in self.modules for r in m.routines]
+
+    @property
+    def data(self) -> list[DataDecl]:
+        return [d for m in self.modules for d in m.data]
+
+    @property
+    def records(self) -> list[RecordDecl]:
+        return [r for m in self.modules for r in m.records]
+
+    @property
+    def span(self) -> Span:
+        return self.modules[0].span

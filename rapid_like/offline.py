@@ -54,10 +54,11 @@ class Outcome:
 DEFAULT_TIME_LIMIT = 3600.0
 
 
-def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[SignalChange] = (),
+def run_offline(module: n.Module | n.Task, signals: list[SignalInfo], changes: list[SignalChange] = (),
                 entry: str = "main", max_time: float | None = None, step: float = 0.012,
                 on_event: Callable[[dict], None] | None = None,
-                default_limit: float = DEFAULT_TIME_LIMIT, loop_budget: int = DEFAULT_LOOP_BUDGET) -> Outcome:
+                default_limit: float = DEFAULT_TIME_LIMIT, loop_budget: int = DEFAULT_LOOP_BUDGET,
+                answers: list[str] | None = None, cycles: int = 1, infer_signals: bool = False) -> Outcome:
     """Run `module` from `entry` until it ends, fails or `max_time` passes. Raises CheckError for
     static errors (nothing has run then).
 
@@ -70,10 +71,16 @@ def run_offline(module: n.Module, signals: list[SignalInfo], changes: list[Signa
         if on_event is not None:
             on_event(ev)
 
-    host = InMemoryHost(list(signals))
+    signals = list(signals)
+    if infer_signals:  # no I/O configuration: the signals the program uses, as the checker infers them
+        from .checker import check
+
+        signals += check(module, {s.name.lower(): s for s in signals}, infer_signals=True).inferred
+    host = InMemoryHost(signals)
     names = {s.name.lower(): s.name for s in signals}
     pending = sorted(((to_ns(c.t), i, c) for i, c in enumerate(changes)), key=lambda x: (x[0], x[1]))
-    ctl = Controller(module, host, entry, on_event=emit, step=step, loop_budget=loop_budget)
+    ctl = Controller(module, host, entry, on_event=emit, step=step, loop_budget=loop_budget, answers=answers,
+                     cycles=cycles)
     limit = None if max_time is None else to_ns(max_time)
     fallback = to_ns(default_limit)
 

@@ -26,16 +26,17 @@ from .values import array_type
 
 # Words that close a block; a statement never starts with one of them.
 _CLOSERS = {"ENDMODULE", "ENDPROC", "ENDFUNC", "ENDTRAP", "ENDIF", "ELSE", "ELSEIF", "ENDWHILE",
-            "ENDFOR", "ENDTEST", "CASE", "DEFAULT", "ERROR"}
+            "ENDFOR", "ENDTEST", "CASE", "DEFAULT", "ERROR", "UNDO", "ENDRECORD"}
 _RELOPS = ("=", "<>", "<", "<=", ">", ">=")
 # The structure each closing word belongs to, for "ENDIF without IF" messages.
 _OWNER = {"ENDIF": "IF", "ELSE": "IF", "ELSEIF": "IF", "ENDWHILE": "WHILE", "ENDFOR": "FOR",
           "ENDTEST": "TEST", "CASE": "TEST", "DEFAULT": "TEST", "ENDPROC": "PROC", "ENDFUNC": "FUNC",
-          "ERROR": "PROC or FUNC", "ENDMODULE": "MODULE", "ENDTRAP": "TRAP"}
+          "ERROR": "PROC, FUNC or TRAP", "UNDO": "PROC, FUNC or TRAP", "ENDMODULE": "MODULE", "ENDTRAP": "TRAP",
+          "ENDRECORD": "RECORD"}
 # Words that end a routine or the module: in a routine body, they are a wrong END word, not a stray one.
 _ROUTINE_ENDS = {"ENDPROC", "ENDFUNC", "ENDTRAP", "ENDMODULE"}
 # The END words an identifier may be a misspelling of ("ENDFI", "END_IF", "EndWhile1").
-_END_WORDS = ("ENDIF", "ENDWHILE", "ENDFOR", "ENDTEST", "ENDPROC", "ENDFUNC", "ENDMODULE")
+_END_WORDS = ("ENDIF", "ENDWHILE", "ENDFOR", "ENDTEST", "ENDPROC", "ENDFUNC", "ENDTRAP", "ENDMODULE")
 
 
 def _looks_like_end_word(word: str) -> bool:
@@ -116,14 +117,20 @@ class Parser:
     # ---- module and declarations -----------------------------------------------------------------
     def module(self) -> n.Module:
         start = self.tok
+        attributes: list[str] = []
+        self.records: list[n.RecordDecl] = []
         if self.tok.is_kw("MODULE"):
             self.advance()
             name = self.expect_ident("a module name after MODULE").text
+            self.module_name = name
             if self.tok.is_op("("):  # module attributes: (SYSMODULE, NOSTEPIN, ...)
+                self.advance()
                 while not self.tok.is_op(")"):
                     if self.tok.kind is Kind.EOF:
                         raise self.error("expected ')' to close the module attributes")
-                    self.advance()
+                    t = self.advance()
+                    if t.kind is Kind.IDENT:
+                        attributes.append(t.text.upper())
                 self.advance()
             data, routines = self.module_items(("ENDMODULE",), f" to close the MODULE on line {start.span.line}")
             self.expect_kw("ENDMODULE")
@@ -131,8 +138,15 @@ class Parser:
                 raise self.error(f"unexpected {self.found()} after ENDMODULE")
         else:
             name = "<anonymous>"
+            self.module_name = name
             data, routines = self.module_items((), "")
-        return n.Module(start.span, name, data, routines, self.file, self.source)
+        for d in data:
+            d.module = name
+        for r in routines:
+            r.module = name
+        for rec in self.records:
+            rec.module = name
+        return n.Module(start.span, name, data, routines, self.file, self.source, self.records, attributes)
 
     def module_items(self, closers: tuple[str, ...], what: str):
         data: list[n.DataDecl] = []
@@ -146,20 +160,40 @@ class Parser:
             if closers and t.is_kw(*closers):
                 return data, routines
             local = False
-            if t.is_kw("LOCAL", "TASK"):
-                local = True
+            if t.is_kw("LOCAL", "TASK"):  # TASK data are global in the task, as the task is all there is
+                local = t.is_kw("LOCAL")
                 self.advance()
             if self.tok.is_kw("VAR", "PERS", "CONST"):
                 data.append(self.data_decl(local))
-            elif self.tok.is_kw("PROC", "FUNC"):
+            elif self.tok.is_kw("PROC", "FUNC", "TRAP"):
                 routines.append(self.routine(local))
-            elif self.tok.is_kw("TRAP"):
-                raise self.error("TRAP routines are not supported by this interpreter")
+            elif self.tok.is_kw("RECORD"):
+                self.records.append(self.record_decl(local))
+            elif self.tok.is_kw("ALIAS"):
+                raise self.error("ALIAS data types are not supported by rapid_like: declare the data with the "
+                                 "type itself")
             elif self.tok.is_kw("ENDMODULE") and not closers:
                 raise self.error("ENDMODULE without MODULE")
             else:
                 raise self.error(f"expected a data declaration (VAR, PERS, CONST) or a routine (PROC, FUNC)"
                                  f"{what and ' in the module'}, found {self.found()}")
+
+    def record_decl(self, local: bool) -> n.RecordDecl:
+        kw = self.advance()
+        name = self.expect_ident("a record type name after RECORD")
+        fields: list[tuple[str, str, Span]] = []
+        while not self.tok.is_kw("ENDRECORD"):
+            if self.tok.kind is Kind.EOF or self.tok.is_kw("PROC", "FUNC", "TRAP", "ENDMODULE", "RECORD"):
+                raise self.error(f"expected ENDRECORD to close the RECORD {name.text} on line {kw.span.line}, "
+                                 f"found {self.found()}")
+            ftype = self.expect_ident(f"a component type in the RECORD {name.text}")
+            fname = self.expect_ident(f"a component name after {ftype.text}")
+            self.expect_op(";", " after the record component", at_previous=True)
+            fields.append((fname.text, ftype.text.lower(), fname.span))
+        self.advance()
+        if not fields:
+            raise self.error(f"the RECORD {name.text} has no components", kw.span)
+        return n.RecordDecl(kw.span, name.text, fields, local)
 
     def data_decl(self, local: bool = False) -> n.DataDecl:
         kw = self.advance()
@@ -245,17 +279,35 @@ class Parser:
         if kind == "FUNC":
             rtype = self.expect_ident("a return type after FUNC").text.lower()
         name = self.expect_ident(f"a name after {kind}")
-        self.expect_op("(", f" after the {kind} name {name.text}")
-        params = self.params()
-        end = "ENDPROC" if kind == "PROC" else "ENDFUNC"
+        if kind == "TRAP":
+            params: list[n.Param] = []
+            if self.tok.is_op("("):
+                raise self.error(f"a TRAP routine takes no parameters: write TRAP {name.text} without '('")
+        else:
+            self.expect_op("(", f" after the {kind} name {name.text}")
+            params = self.params()
+        end = {"PROC": "ENDPROC", "FUNC": "ENDFUNC", "TRAP": "ENDTRAP"}[kind]
         opener = f"{kind} {name.text} on line {kw.span.line}"
-        body = self.block((end, "ERROR"), end, opener)
-        handler = None
+        body = self.block((end, "ERROR", "UNDO", "BACKWARD"), end, opener)
+        handler = error_list = undo = None
+        if self.tok.is_kw("BACKWARD"):
+            raise self.error("BACKWARD handlers are not supported by rapid_like (the program never runs backwards)")
         if self.tok.is_kw("ERROR"):
             self.advance()
-            handler = self.block((end,), end, opener)
+            if self.tok.is_op("("):  # ERROR (ERR_A, ERR_B): the error numbers this handler takes
+                paren = self.advance()
+                error_list = [self.expression()]
+                while self.tok.is_op(","):
+                    self.advance()
+                    error_list.append(self.expression())
+                self.expect_op(")", f" to close the error list on line {paren.span.line}")
+            handler = self.block((end, "UNDO"), end, opener)
+        if self.tok.is_kw("UNDO"):
+            self.advance()
+            undo = self.block((end,), end, opener)
         closing = self.expect_kw(end)
-        return n.Routine(kw.span, kind, name.text, params, body, handler, rtype, local, closing.span)
+        return n.Routine(kw.span, kind, name.text, params, body, handler, rtype, local, closing.span,
+                         error_list, undo)
 
     def params(self) -> list[n.Param]:
         params: list[n.Param] = []
@@ -312,14 +364,17 @@ class Parser:
         reported as the missing `expected` word of `opener`."""
         stmts: list[n.Stmt] = []
         self.open_closers.append(closers)
-        in_routine = expected in ("ENDPROC", "ENDFUNC")  # the body (or ERROR handler) of a routine
+        in_routine = expected in ("ENDPROC", "ENDFUNC", "ENDTRAP")  # the body (or ERROR handler) of a routine
         try:
             while True:
                 t = self.tok
                 if t.kind is Kind.KEYWORD and t.upper in closers:
                     return stmts
                 if in_routine and t.is_kw("ERROR") and "ERROR" not in closers:
-                    raise self.error(f"a second ERROR in the {opener}: a routine has one ERROR handler")
+                    raise self.error(f"a second ERROR in the {opener}: a routine has one ERROR handler"
+                                     + (", before its UNDO" if "UNDO" in closers else ""))
+                if in_routine and t.is_kw("UNDO") and "UNDO" not in closers:
+                    raise self.error(f"a second UNDO in the {opener}: a routine has one UNDO section, at its end")
                 if in_routine and t.kind is Kind.KEYWORD and t.upper in _CLOSERS and \
                         t.upper not in _ROUTINE_ENDS and not any(t.upper in c for c in self.open_closers):
                     raise self.error(f"{t.upper} without {_OWNER[t.upper]}: no {_OWNER[t.upper]} is open here")
@@ -364,6 +419,15 @@ class Parser:
                 return n.LocalDecl(decl.span, decl)
             if w in ("RETURN", "EXIT", "RETRY", "TRYNEXT", "RAISE"):
                 return self.keyword_instruction()
+            if w == "CONNECT":
+                self.advance()
+                target = self.postfix(self.name_expr()) if self.tok.kind is Kind.IDENT else None
+                if target is None:
+                    raise self.error(f"expected an interrupt variable (intnum) after CONNECT, found {self.found()}")
+                self.expect_kw("WITH", f" after CONNECT {target.text} (CONNECT intno WITH trap_routine;)")
+                trap = self.expect_ident("the name of a TRAP routine after WITH")
+                self.end_of_instruction()
+                return n.Connect(t.span, target, trap.text, trap.span)
             if w == "GOTO":
                 self.advance()
                 label = self.expect_ident("a label after GOTO")

@@ -51,6 +51,10 @@ class ExitSignal(Exception):
     """EXIT: the program ends."""
 
 
+class ExitCycleSignal(Exception):
+    """ExitCycle: the cycle ends; the next one starts from the entry routine (data keep their values)."""
+
+
 class GotoSignal(Exception):
     """GOTO: caught by the innermost block around it that holds the label."""
 
@@ -137,6 +141,7 @@ class Frame:
     vars: dict[str, object] = field(default_factory=dict)
     in_handler: bool = False
     error: ExecError | None = None
+    undoing: bool = False
 
 
 def component_type(t: str, path: list) -> str:

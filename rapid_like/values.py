@@ -15,7 +15,14 @@ from dataclasses import dataclass
 
 NUM, BOOL, STRING = "num", "bool", "string"
 STRING_MAX = 80  # characters in a RAPID string (longer: a static error in a literal, else ERR_STRTOOLNG)
-NUMERIC = {"num", "dnum", "errnum", "intnum", "dionum"}
+# Types whose values are nums (RAPID's aliases of num and dnum, and the enumerations it keeps in them).
+NUMERIC = {"num", "dnum", "errnum", "intnum", "dionum", "byte", "errdomain", "errtype", "opnum", "socketstatus",
+           "tpnum", "btnres", "icondata", "buttondata", "listitem_type", "event_type", "handler_type", "iounit_state",
+           "signalorigin", "sensorstate", "paridnum", "paridvalidnum", "opcalc", "symnum", "uishownum"}
+# Types whose values the program can only hold and pass on (no components, no literals); their
+# default value is an `Opaque` the instructions that use them fill in.
+OPAQUE_TYPES = {"socketdev", "rawbytes", "iodev", "triggdata", "wzstationary", "wztemporary", "shapedata",
+                "mecunit", "restartdata", "syncident", "tasks", "dir", "datapos", "pathrecid", "btnvalue"}
 ATOMIC = NUMERIC | {BOOL, STRING}
 SIGNAL_TYPES = {"signaldi": "DI", "signaldo": "DO", "signalai": "AI", "signalao": "AO",
                 "signalgi": "GI", "signalgo": "GO"}
@@ -44,7 +51,44 @@ RECORDS: dict[str, list[tuple[str, str]]] = {
     "wobjdata": [("robhold", BOOL), ("ufprog", BOOL), ("ufmec", STRING), ("uframe", "pose"),
                  ("oframe", "pose")],
 }
-KNOWN_TYPES = ATOMIC | set(RECORDS) | set(SIGNAL_TYPES) | {"clock"}
+BUILTIN_RECORDS = frozenset(RECORDS)
+KNOWN_TYPES = ATOMIC | set(RECORDS) | set(SIGNAL_TYPES) | {"clock"} | OPAQUE_TYPES | {"errstr", "stringdig"}
+
+
+def define_records(decls: list[tuple[str, list[tuple[str, str]]]]) -> None:
+    """Make user RECORD types known (lower-case name, [(component, type)]). A program's records replace
+    those of a program loaded before it; RAPID's own record types cannot be redefined (the checker
+    reports that)."""
+    for name, fields in decls:
+        if name in BUILTIN_RECORDS:
+            continue
+        RECORDS[name] = [(f.lower(), t) for f, t in fields]
+        KNOWN_TYPES.add(name)
+
+
+class Opaque:
+    """A value of a type the program cannot look into (socketdev, rawbytes, iodev, ...); `state` is
+    whatever the instructions that use it keep there. Copies share the state, like a RAPID
+    reference to a device."""
+
+    __slots__ = ("type", "state")
+
+    def __init__(self, type_: str, state: object = None):
+        self.type, self.state = type_, state
+
+    def copy(self) -> "Opaque":
+        """rawbytes are data (copied); devices (socketdev, iodev, ...) are references (shared)."""
+        if isinstance(self.state, RawBytes):
+            c = RawBytes()
+            c.data = bytearray(self.state.data)
+            return Opaque(self.type, c)
+        return self
+
+    def __eq__(self, other: object) -> bool:
+        return self is other
+
+    def __hash__(self) -> int:
+        return id(self)
 
 
 class Record:
@@ -57,7 +101,8 @@ class Record:
         self.fields = fields
 
     def copy(self) -> "Record":
-        return Record(self.type, {k: (v.copy() if isinstance(v, Record) else v) for k, v in self.fields.items()})
+        return Record(self.type, {k: (v.copy() if isinstance(v, (Record, Opaque, Array)) else v)
+                                  for k, v in self.fields.items()})
 
     def values(self) -> list[object]:
         return list(self.fields.values())
@@ -145,7 +190,11 @@ def base_type(t: str) -> str:
     if t.endswith("}") and "{" in t:
         elem, dims = t[:-1].split("{", 1)
         return f"{base_type(elem)}{{{dims}}}"
-    return NUM if t in NUMERIC else t
+    if t in NUMERIC:
+        return NUM
+    if t in ("errstr", "stringdig"):
+        return STRING
+    return t
 
 
 def default_value(t: str) -> object:
@@ -160,7 +209,18 @@ def default_value(t: str) -> object:
         return Record(t, {name: default_value(ft) for name, ft in RECORDS[t]})
     if t == "clock":
         return Clock()
+    if t in OPAQUE_TYPES:
+        return Opaque(t, RawBytes() if t == "rawbytes" else None)
     raise TypeMismatch(f"no default value for type {t}")
+
+
+class RawBytes:
+    """The contents of a rawbytes: up to 1024 bytes (PackRawBytes, SocketReceive \\RawData ...)."""
+
+    __slots__ = ("data",)
+
+    def __init__(self) -> None:
+        self.data = bytearray()
 
 
 def type_of(v: object) -> str:
@@ -180,6 +240,8 @@ def type_of(v: object) -> str:
         return array_type(v.elem, v.ndims)
     if isinstance(v, Aggregate):
         return "aggregate"
+    if isinstance(v, Opaque):
+        return v.type
     return type(v).__name__
 
 
@@ -212,6 +274,9 @@ def coerce(v: object, t: str) -> object:
             return Record(t, out)
     elif t == "clock":
         if isinstance(v, Clock):
+            return v
+    elif t in OPAQUE_TYPES:
+        if isinstance(v, Opaque) and v.type == t:
             return v
     elif t in SIGNAL_TYPES:
         if isinstance(v, SignalRef) and v.kind == SIGNAL_TYPES[t]:

@@ -64,7 +64,7 @@ def test_unknown_entry_is_a_static_error(prog: Path):
 
 
 def test_a_signal_missing_from_io_fails_before_anything_runs(prog: Path):
-    code, out, err = run_cli(["run", str(prog), "--trace"])
+    code, out, err = run_cli(["run", str(prog), "--io", "DI:diOther", "--trace"])
     assert code == 65
     assert out == ""  # not even the TPWrite on the line before
     assert err.startswith(f"{prog}:4:11: error: undefined name 'doLamp'")
@@ -91,8 +91,17 @@ def test_missing_file_exits_66(tmp_path: Path):
 
 def test_check_reports_ok_without_running(prog: Path):
     assert run_cli(["check", str(prog), "--io", "DO:doLamp"]) == (0, "", "")
-    code, _, err = run_cli(["check", str(prog)])
+    code, _, err = run_cli(["check", str(prog), "--io", "DI:diOther"])
     assert code == 65 and "doLamp" in err
+
+
+def test_without_any_io_the_signals_are_taken_from_the_program_and_check_says_so(prog: Path):
+    code, out, err = run_cli(["check", str(prog)])
+    assert (code, err) == (0, "")
+    assert f"{prog}:4:11: warning: doLamp is not a configured I/O signal: taken as a DO from its use" in out
+    code, out, err = run_cli(["run", str(prog), "--trace"])
+    assert code == 0, err
+    assert {"t": 0.0, "type": "DO", "signal": "doLamp", "value": 1} in [json.loads(x) for x in out.splitlines()]
 
 
 def test_io_accepts_comma_lists_and_repeats(tmp_path: Path):

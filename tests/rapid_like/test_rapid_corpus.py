@@ -3,6 +3,7 @@
 Each `.mod` file states its own expectations in comments (as craftinginterpreters' test/*.lox do):
 
     ! args: --io DI:di1,DO:do1 --set di1=1@0.5      extra arguments for `rapid run` (repeatable)
+    ! modules: parts/cell.sys parts/grip.modx        more modules of the task (beside the file)
     ! trace: {"t": 0.0, "type": "print", "text": "x"}  the trace, line by line, in order (whole trace)
     ! error: 4:10 division by zero                   stderr holds FILE:4:10: error: ...division by zero...
     ! exit: 70                                       the exit status (0 when not given)
@@ -27,7 +28,7 @@ FILES = sorted(CORPUS.rglob("*.mod"))
 
 
 def expectations(path: Path) -> dict:
-    exp: dict = {"args": [], "trace": [], "error": None, "exit": 0}
+    exp: dict = {"args": [], "trace": [], "error": None, "exit": 0, "modules": []}
     for line in path.read_text().splitlines():
         s = line.strip()
         if not s.startswith("!"):
@@ -37,6 +38,8 @@ def expectations(path: Path) -> dict:
         key, rest = key.strip().lower(), rest.strip()
         if key == "args":
             exp["args"] += shlex.split(rest)
+        elif key == "modules":
+            exp["modules"] += [str(path.parent / m) for m in rest.split()]
         elif key == "trace":
             exp["trace"].append(json.loads(rest))
         elif key == "error":
@@ -61,7 +64,7 @@ def test_corpus_is_not_empty():
 @pytest.mark.parametrize("path", FILES, ids=[str(p.relative_to(CORPUS)) for p in FILES])
 def test_program(path: Path):
     exp = expectations(path)
-    argv = ["run", str(path), *exp["args"]]
+    argv = ["run", str(path), *exp["modules"], *exp["args"]]
     if exp["trace"]:
         argv.append("--trace")
     code, out, err = run_cli(argv)

@@ -1,0 +1,661 @@
+"""Built-ins beyond motion and plain I/O, as a mixin of the evaluator: FlexPendant dialogs answered
+from a script, the event log (ErrWrite), ExitCycle, interrupt orders, path control, system and time
+functions, group and analog I/O waits, pose maths, bits, strings and rawbytes.
+
+Values in simulation (documented in docs/rapid.md):
+- dialogs (TPReadFK, TPReadNum, UIMessageBox, UIMsgBox, UINumEntry, UIAlphaEntry) take the next
+  `--answer` value; with none left a dialog with \\MaxTime times out after it (ERR_TP_MAXTIME), one
+  without is the runtime error ERR_TP_NO_CLIENT naming the dialog;
+- OpMode() is OP_AUTO, RunMode() RUN_CONT_CYCLE, RobOS() FALSE (not a real controller);
+- CDate/CTime/GetTime count simulated time from 2024-01-01 00:00:00 (a Monday);
+- GetSysInfo(\\LanIp) is 127.0.0.1 (sockets bound to it are reachable on loopback).
+"""
+from __future__ import annotations
+
+import datetime
+import math
+
+from . import builtins as B
+from . import nodes as n
+from . import strings as S
+from .runtime import ExitCycleSignal, Frame, Ref, Wait, to_ns
+from .values import (Aggregate, Opaque, RawBytes, Record, coerce, fmt_num, format_value, pos, record, xyz)
+
+SYSINFO = {"serialno": "rapid_like-0001", "swversion": "rapid_like", "robottype": "simulated robot",
+           "ctrlid": "rapid_like", "lanip": "127.0.0.1", "ctrllang": "en", "systemname": "rapid_like"}
+_BUTTONS = {  # buttondata -> the btnres of each button, in order
+    -1: [], 0: ["resOK"], 1: ["resAbort", "resRetry", "resIgnore"], 2: ["resOK", "resCancel"],
+    3: ["resRetry", "resCancel"], 4: ["resYes", "resNo"], 5: ["resYes", "resNo", "resCancel"]}
+
+
+class SystemMixin:
+    # ---- FlexPendant dialogs ---------------------------------------------------------------------
+    def _answer(self, s, what: str, arg, bound):
+        """The next --answer for a dialog, or None after \\MaxTime when there is none (a generator)."""
+        if self.answers:
+            return self.answers.pop(0)
+        maxtime = arg("maxtime")
+        if maxtime is None:
+            raise self.fail(f"{what}: no answer for this FlexPendant dialog (give one with --answer, or in the "
+                            f"station's controller answers)", s.span, "ERR_TP_NO_CLIENT")
+        until = self.now + to_ns(maxtime)
+        while self.now < until:
+            yield from self.pause(Wait("time", until, what, s.span))
+        flag = arg("breakflag")
+        if flag is not None:
+            flag.set(float(B.ERRORS["ERR_TP_MAXTIME"]))
+            return None
+        raise self.fail(f"{what}: no answer within \\MaxTime", s.span, "ERR_TP_MAXTIME")
+
+    def _dialog_event(self, instr: str, text: str, answer: object) -> None:
+        self.emit({"type": "dialog", "instr": instr, "text": text, "answer": answer})
+
+    def i_tpreadfk(self, s, arg, text, bound):
+        keys = [arg(f"tpfk{i}") for i in range(1, 6)]
+        prompt = arg("tptext")
+        answer = yield from self._answer(s, f'TPReadFK "{prompt}"', arg, bound)
+        if answer is None:
+            arg("tpanswer").set(0.0)
+            return
+        choice = None
+        if answer.strip().isdigit() and 1 <= int(answer) <= 5:
+            choice = int(answer)
+        else:
+            for i, k in enumerate(keys, 1):
+                if k and k.strip().lower() == answer.strip().lower():
+                    choice = i
+        if choice is None or not keys[choice - 1]:
+            offered = ", ".join(f"{i}={k}" for i, k in enumerate(keys, 1) if k)
+            raise self.fail(f'TPReadFK "{prompt}": the answer {answer!r} is not one of its keys ({offered})', s.span,
+                            "ERR_ARGVALERR")
+        arg("tpanswer").set(float(choice))
+        self._dialog_event("TPReadFK", prompt, choice)
+
+    def i_tpreadnum(self, s, arg, text, bound, name="TPReadNum"):
+        prompt = arg("tptext")
+        answer = yield from self._answer(s, f'{name} "{prompt}"', arg, bound)
+        if answer is None:
+            return
+        value = self._number_answer(s, name, prompt, answer)
+        arg("tpanswer").set(value)
+        self._dialog_event(name, prompt, value)
+
+    def i_tpreaddnum(self, s, arg, text, bound):
+        yield from self.i_tpreadnum(s, arg, text, bound, "TPReadDnum")
+
+    def _number_answer(self, s, name: str, prompt: str, answer: str) -> float:
+        try:
+            return float(answer)
+        except ValueError:
+            raise self.fail(f'{name} "{prompt}": the answer {answer!r} is not a number', s.span,
+                            "ERR_ARGVALERR") from None
+
+    def _button(self, s, name: str, prompt: str, answer: str, buttons: float | None) -> float:
+        consts = B.predefined_data()
+        a = answer.strip()
+        for k in (a, "res" + a):
+            if k.lower() in consts and consts[k.lower()][0] == "btnres":
+                return float(consts[k.lower()][1])  # type: ignore[arg-type]
+        if a.isdigit():
+            choices = _BUTTONS.get(int(buttons if buttons is not None else 0), [])
+            if 1 <= int(a) <= len(choices):
+                return float(consts[choices[int(a) - 1].lower()][1])  # type: ignore[arg-type]
+        raise self.fail(f'{name} "{prompt}": the answer {answer!r} is not a button (resOK, resYes, ... or its '
+                        f'number on the dialog)', s.span, "ERR_ARGVALERR")
+
+    def i_uimsgbox(self, s, arg, text, bound):
+        prompt = " ".join(x for x in (arg(f"msgline{i}") for i in range(1, 6)) if x)
+        answer = yield from self._answer(s, f'UIMsgBox "{prompt}"', arg, bound)
+        if answer is None:
+            return
+        value = self._button(s, "UIMsgBox", prompt, answer, arg("buttons"))
+        result = arg("result")
+        if result is not None:
+            result.set(value)
+        self._dialog_event("UIMsgBox", prompt, value)
+
+    def i_tpshow(self, s, arg, text, bound):
+        arg("window")
+        yield from ()
+
+    # Dialog functions cannot wait (a FUNC cannot): without an answer they fail at once.
+    def _function_answer(self, e, what: str):
+        if not self.answers:
+            raise self.fail(f"{what}: no answer for this FlexPendant dialog (give one with --answer, or in the "
+                            f"station's controller answers)", e.span, "ERR_TP_NO_CLIENT")
+        return self.answers.pop(0)
+
+    def _message(self, arg) -> str:
+        text = arg("message")
+        if text is None and arg("msgarray") is not None:
+            text = " ".join(arg("msgarray"))
+        return text or arg("header") or ""
+
+    def f_uimessagebox(self, e, arg, bound):
+        prompt = self._message(arg)
+        answer = self._function_answer(e, f'UIMessageBox "{prompt}"')
+        btns = arg("btnarray")
+        if btns is not None:
+            a = answer.strip()
+            choice = int(a) if a.isdigit() else next((i for i, b in enumerate(btns, 1) if b.lower() == a.lower()), 0)
+            if not 1 <= choice <= len(btns):
+                raise self.fail(f'UIMessageBox "{prompt}": the answer {answer!r} is not one of its buttons', e.span,
+                                "ERR_ARGVALERR")
+            value = float(choice)
+        else:
+            value = self._button(e, "UIMessageBox", prompt, answer, arg("buttons"))
+        self._dialog_event("UIMessageBox", prompt, value)
+        return value
+
+    def f_uinumentry(self, e, arg, bound):
+        prompt = self._message(arg)
+        value = self._number_answer(e, "UINumEntry", prompt, self._function_answer(e, f'UINumEntry "{prompt}"'))
+        lo, hi = arg("minvalue"), arg("maxvalue")
+        if lo is not None and value < lo:
+            raise self.fail(f"UINumEntry: the answer {fmt_num(value)} is below \\MinValue {fmt_num(lo)}", e.span,
+                            "ERR_UI_MIN")
+        if hi is not None and value > hi:
+            raise self.fail(f"UINumEntry: the answer {fmt_num(value)} is above \\MaxValue {fmt_num(hi)}", e.span,
+                            "ERR_UI_MAX")
+        if arg("asinteger") and value != int(value):
+            raise self.fail(f"UINumEntry \\AsInteger: the answer {fmt_num(value)} is not an integer", e.span,
+                            "ERR_UI_NOTINT")
+        self._dialog_event("UINumEntry", prompt, value)
+        return value
+
+    def f_uialphaentry(self, e, arg, bound):
+        prompt = self._message(arg)
+        answer = self.string(self._function_answer(e, f'UIAlphaEntry "{prompt}"'), e.span)
+        self._dialog_event("UIAlphaEntry", prompt, answer)
+        return answer
+
+    # ---- event log, cycle ------------------------------------------------------------------------
+    def i_errwrite(self, s, arg, text, bound):
+        level = "warning" if arg("w") else "info" if arg("i") else "error"
+        ev = {"type": "errlog", "level": level, "header": arg("header"), "reason": arg("reason")}
+        for k in ("rl2", "rl3", "rl4"):
+            if arg(k) is not None:
+                ev[k] = arg(k)
+        self.emit(ev)
+        yield from ()
+
+    def i_skipwarn(self, s, arg, text, bound):
+        yield from ()
+
+    def i_exitcycle(self, s, arg, text, bound):
+        raise ExitCycleSignal()
+        yield  # pragma: no cover
+
+    def i_spystart(self, s, arg, text, bound):
+        arg("file")
+        yield from ()
+
+    def i_spystop(self, s, arg, text, bound):
+        yield from ()
+
+    # ---- interrupts --------------------------------------------------------------------------------
+    def _intno(self, arg, bound) -> int:
+        return self.interrupts.number(arg("interrupt"), bound["interrupt"].value.span)
+
+    def i_isignaldi(self, s, arg, text, bound):
+        no = self._intno(arg, bound)
+        trig = arg("triggvalue")
+        if trig not in (0, 1, 2):
+            raise self.fail(f"{s.name}: TriggValue must be 0, 1 or edge (2), not {fmt_num(trig)}",
+                            bound["triggvalue"].value.span, "ERR_ARGVALERR")
+        self.interrupts.signal_order(no, arg("signal").name, trig, bool(arg("single") or arg("singlesafe")))
+        yield from ()
+
+    i_isignaldo = i_isignaldi
+
+    def i_isignalgi(self, s, arg, text, bound):
+        no = self._intno(arg, bound)
+        self.interrupts.signal_order(no, arg("signal").name, None, bool(arg("single") or arg("singlesafe")))
+        yield from ()
+
+    i_isignalgo = i_isignalgi
+
+    def i_itimer(self, s, arg, text, bound):
+        no = self._intno(arg, bound)
+        t = arg("time")
+        if t <= 0:
+            raise self.fail(f"ITimer needs a time > 0, not {fmt_num(t)}", bound["time"].value.span, "ERR_ARGVALERR")
+        self.interrupts.timer_order(no, t, bool(arg("single") or arg("singlesafe")))
+        yield from ()
+
+    def i_ipers(self, s, arg, text, bound):
+        no = self._intno(arg, bound)
+        self.interrupts.pers_order(no, arg("name"))
+        yield from ()
+
+    def i_ierror(self, s, arg, text, bound):
+        self._intno(arg, bound)
+        yield from ()
+
+    def i_idelete(self, s, arg, text, bound):
+        self.interrupts.delete(int(arg("interrupt")))
+        yield from ()
+
+    def i_isleep(self, s, arg, text, bound):
+        self.interrupts.sleep(self._intno(arg, bound), True)
+        yield from ()
+
+    def i_iwatch(self, s, arg, text, bound):
+        self.interrupts.sleep(self._intno(arg, bound), False)
+        yield from ()
+
+    def i_idisable(self, s, arg, text, bound):
+        self.interrupts.enabled = False
+        yield from ()
+
+    def i_ienable(self, s, arg, text, bound):
+        self.interrupts.enabled = True
+        yield from ()
+
+    # ---- synchronisation ---------------------------------------------------------------------------
+    def i_waittestandset(self, s, arg, text, bound):
+        ref = arg("object")
+        while ref.get():
+            yield from self.pause(Wait("signal", None, f"WaitTestAndSet {text('object')}", s.span))
+        ref.set(True)
+
+    def f_testandset(self, e, arg, bound):
+        ref = arg("object")
+        was = ref.get()
+        ref.set(True)
+        return not was
+
+    # ---- path control (motions are not queued: see docs/rapid.md) ---------------------------------
+    def i_stopmove(self, s, arg, text, bound):
+        self.stop_move = True
+        yield from ()
+
+    def i_startmove(self, s, arg, text, bound):
+        self.stop_move = False
+        yield from ()
+
+    i_stopmovereset = i_startmove
+    i_startmoveretry = i_startmove
+
+    def _accept(self, s, arg, text, bound):
+        for k in bound:
+            arg(k)
+        yield from ()
+
+    i_clearpath = i_storepath = i_restopath = i_singarea = i_cirpathmode = i_pathresol = _accept
+    i_gripload = i_worldacclim = i_pathacclim = i_pdispoff = i_pdispset = i_eoffsoff = _accept
+
+    # ---- group and analog waits --------------------------------------------------------------------
+    def _compare(self, arg):
+        value = arg("value")
+        if arg("noteq"):
+            return lambda v: v != value
+        if arg("lt"):
+            return lambda v: v < value
+        if arg("gt"):
+            return lambda v: v > value
+        return lambda v: v == value
+
+    def i_waitgi(self, s, arg, text, bound, name="WaitGI"):
+        sig, test = arg("signal"), self._compare(arg)
+        yield from self._wait_cond(s, arg, bound, lambda: test(self.host.read_signal(sig.name)), f"{name} {sig.name}",
+                                   None)
+
+    def i_waitgo(self, s, arg, text, bound):
+        yield from self.i_waitgi(s, arg, text, bound, "WaitGO")
+
+    def i_waitai(self, s, arg, text, bound, name="WaitAI"):
+        sig, test = arg("signal"), self._compare(arg)
+        at_timeout = arg("valueattimeout")
+        maxtime = arg("maxtime")
+        deadline = None if maxtime is None else self.now + to_ns(maxtime)
+        while not test(self.host.read_signal(sig.name)):
+            if deadline is not None and self.now >= deadline:
+                if at_timeout is not None:
+                    at_timeout.set(float(self.host.read_signal(sig.name)))
+                raise self.fail(f"{name} {sig.name} timed out: \\MaxTime of {fmt_num(maxtime)} s ran out", s.span,
+                                "ERR_WAIT_MAXTIME")
+            yield from self.pause(Wait("signal", deadline, f"{name} {sig.name}", s.span))
+
+    def i_waitao(self, s, arg, text, bound):
+        yield from self.i_waitai(s, arg, text, bound, "WaitAO")
+
+    # ---- bits -----------------------------------------------------------------------------------
+    def _bit(self, bound, arg, key="bitpos") -> int:
+        p = arg(key)
+        if p != int(p) or not 1 <= p <= 8:
+            raise self.fail(f"a bit position is 1 to 8, not {fmt_num(p)}", bound[key].value.span, "ERR_ARGVALERR")
+        return int(p) - 1
+
+    def i_bitset(self, s, arg, text, bound):
+        ref = arg("bitdata")
+        ref.set(float(int(ref.get()) | (1 << self._bit(bound, arg))))
+        yield from ()
+
+    def i_bitclear(self, s, arg, text, bound):
+        ref = arg("bitdata")
+        ref.set(float(int(ref.get()) & ~(1 << self._bit(bound, arg)) & 0xFF))
+        yield from ()
+
+    def f_bitcheck(self, e, arg, bound):
+        return bool(int(arg("bitdata")) >> self._bit(bound, arg) & 1)
+
+    # ---- rawbytes --------------------------------------------------------------------------------
+    def _raw(self, value) -> RawBytes:
+        if isinstance(value, Ref):
+            value = value.get()
+        return value.state  # type: ignore[union-attr]
+
+    def i_clearrawbytes(self, s, arg, text, bound):
+        raw = self._raw(arg("rawdata"))
+        start = arg("fromindex", 1.0)
+        del raw.data[max(int(start) - 1, 0):]
+        yield from ()
+
+    def i_packrawbytes(self, s, arg, text, bound):
+        raw = self._raw(arg("rawdata"))
+        value = arg("value")
+        start = int(arg("startindex"))
+        intx = arg("intx")
+        try:
+            data = S.pack(value, int(intx) if intx is not None else None, bool(arg("float4")), bool(arg("hex1")),
+                          bool(arg("network")))
+        except (ValueError, TypeError, OverflowError) as exc:
+            raise self.fail(f"PackRawBytes: {exc}", s.span, "ERR_ARGVALERR") from None
+        if not 1 <= start <= len(raw.data) + 1 or start - 1 + len(data) > S.RAWBYTES_MAX:
+            raise self.fail(f"PackRawBytes: StartIndex {start} is outside the rawbytes (length {len(raw.data)}, "
+                            f"at most {S.RAWBYTES_MAX})", bound["startindex"].value.span, "ERR_OUTOFBND")
+        raw.data[start - 1:start - 1 + len(data)] = data
+        yield from ()
+
+    def i_unpackrawbytes(self, s, arg, text, bound):
+        raw = self._raw(arg("rawdata"))
+        start = int(arg("startindex"))
+        target = arg("value")
+        intx, ascii_len = arg("intx"), arg("ascii")
+        try:
+            value = S.unpack(raw.data, start, int(intx) if intx is not None else None, bool(arg("float4")),
+                             int(ascii_len) if ascii_len is not None else None, bool(arg("hex1")),
+                             bool(arg("network")))
+        except IndexError:
+            raise self.fail(f"UnpackRawBytes: bytes from {start} are outside the rawbytes (length {len(raw.data)})",
+                            bound["startindex"].value.span, "ERR_OUTOFBND") from None
+        except ValueError as exc:
+            raise self.fail(f"UnpackRawBytes: {exc}", s.span, "ERR_ARGVALERR") from None
+        target.set(self.coerce(value, target.type, bound["value"].value.span))
+        yield from ()
+
+    def i_copyrawbytes(self, s, arg, text, bound):
+        src, dst = self._raw(arg("fromrawdata")), self._raw(arg("torawdata"))
+        i, j = int(arg("fromindex")) - 1, int(arg("toindex")) - 1
+        count = arg("noofbytes")
+        chunk = src.data[i:] if count is None else src.data[i:i + int(count)]
+        if j > len(dst.data) or j + len(chunk) > S.RAWBYTES_MAX:
+            raise self.fail("CopyRawBytes: ToIndex is outside the rawbytes", bound["toindex"].value.span,
+                            "ERR_OUTOFBND")
+        dst.data[j:j + len(chunk)] = chunk
+        yield from ()
+
+    def f_rawbyteslen(self, e, arg, bound):
+        return float(len(self._raw(arg("rawdata")).data))
+
+    # ---- system and time functions -----------------------------------------------------------------
+    def _clock(self) -> datetime.datetime:
+        self.changes += 1  # depends on the time
+        return datetime.datetime(*B.SIMULATED_DATE) + datetime.timedelta(microseconds=self.now // 1000)
+
+    def f_cdate(self, e, arg, bound):
+        return self._clock().strftime("%Y-%m-%d")
+
+    def f_ctime(self, e, arg, bound):
+        return self._clock().strftime("%H:%M:%S")
+
+    def f_gettime(self, e, arg, bound):
+        t = self._clock()
+        if arg("wday"):
+            return float(t.isoweekday())
+        if arg("hour"):
+            return float(t.hour)
+        if arg("min"):
+            return float(t.minute)
+        if arg("sec"):
+            return float(t.second)
+        raise self.fail("GetTime needs one of \\WDay, \\Hour, \\Min or \\Sec", e.span, "ERR_ARGVALERR")
+
+    def f_getsysinfo(self, e, arg, bound):
+        for k in bound:
+            return SYSINFO.get(k, "")
+        return SYSINFO["serialno"]
+
+    def f_opmode(self, e, arg, bound):
+        return float(B.predefined_data()["op_auto"][1])  # type: ignore[arg-type]
+
+    def f_runmode(self, e, arg, bound):
+        return float(B.predefined_data()["run_cont_cycle"][1])  # type: ignore[arg-type]
+
+    def f_isstopmoveact(self, e, arg, bound):
+        return self.stop_move
+
+    def f_gettaskname(self, e, arg, bound):
+        no = arg("taskno")
+        if no is not None:
+            no.set(1.0)
+        return "T_ROB1"
+
+    def f_robos(self, e, arg, bound):
+        return False
+
+    def f_taskrunrob(self, e, arg, bound):
+        return True
+
+    f_taskrunmec = f_taskrunrob
+
+    def f_ismechunitactive(self, e, arg, bound):
+        return True
+
+    def f_cspeedoverride(self, e, arg, bound):
+        return 100.0
+
+    def f_maxrobspeed(self, e, arg, bound):
+        return 5000.0
+
+    # ---- I/O ---------------------------------------------------------------------------------------
+    def f_ginput(self, e, arg, bound):
+        return float(self.host.read_signal(arg("signal").name))
+
+    f_ainput = f_ginput
+
+    # ---- pose maths --------------------------------------------------------------------------------
+    def f_posemult(self, e, arg, bound):
+        return _pose_record(B.pose_mul(B.pose_of(arg("pose1")), B.pose_of(arg("pose2"))))
+
+    def f_poseinv(self, e, arg, bound):
+        return _pose_record(B.pose_inv(B.pose_of(arg("pose"))))
+
+    def f_posevect(self, e, arg, bound):
+        t, q = B.pose_of(arg("pose"))
+        d = B.qrotate(q, list(xyz(arg("pos"))))
+        return pos(*(B._clean(t[i] + d[i]) for i in range(3)))
+
+    def f_defframe(self, e, arg, bound):
+        p1, p2, p3 = (list(xyz(arg(k).fields["trans"])) for k in ("originp1", "originp2", "originp3"))
+        origin = int(arg("origin", 1.0))
+        x = _unit([b - a for a, b in zip(p1, p2)])
+        v = [c - a for a, c in zip(p1, p3)]
+        along = sum(a * b for a, b in zip(v, x))
+        y = _unit([vi - along * xi for vi, xi in zip(v, x)])
+        if x is None or y is None:
+            raise self.fail("DefFrame: the three points are on one line", e.span, "ERR_FRAME")
+        z = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]
+        o = p1 if origin != 2 else [a + along * xi for a, xi in zip(p1, x)]
+        return _pose_record((o, _quat_from_axes(x, y, z)))
+
+    def f_cpos(self, e, arg, bound):
+        return self.host.current_robtarget(arg("tool"), arg("wobj")).fields["trans"]
+
+    def f_ctool(self, e, arg, bound):
+        return self.active_tool.copy()
+
+    def f_cwobj(self, e, arg, bound):
+        return self.active_wobj.copy()
+
+    def f_vectmagn(self, e, arg, bound):
+        return math.sqrt(sum(c * c for c in xyz(arg("vector"))))
+
+    def f_dotprod(self, e, arg, bound):
+        return sum(a * b for a, b in zip(xyz(arg("vector1")), xyz(arg("vector2"))))
+
+    def f_norient(self, e, arg, bound):
+        o = arg("rotation")
+        q = [o.fields[k] for k in ("q1", "q2", "q3", "q4")]
+        norm = math.sqrt(sum(c * c for c in q)) or 1.0
+        return Record("orient", dict(zip(("q1", "q2", "q3", "q4"), (c / norm for c in q))))
+
+    # ---- strings and bytes ---------------------------------------------------------------------------
+    def _chpos(self, e, bound, arg, s: str) -> int:
+        p = arg("chpos")
+        if p != int(p) or not 1 <= p <= len(s) + 1:
+            raise self.fail(f"{e.name}: ChPos {fmt_num(p)} is outside the string (1 to {len(s) + 1})",
+                            bound["chpos"].value.span, "ERR_OUTOFBND")
+        return int(p)
+
+    def f_strfind(self, e, arg, bound):
+        s = arg("str")
+        return float(S.str_find(s, self._chpos(e, bound, arg, s), arg("set"), bool(arg("notinset"))))
+
+    def f_strmatch(self, e, arg, bound):
+        s = arg("str")
+        return float(S.str_match(s, self._chpos(e, bound, arg, s), arg("pattern")))
+
+    def f_strmemb(self, e, arg, bound):
+        s = arg("str")
+        p = self._chpos(e, bound, arg, s)
+        return p <= len(s) and s[p - 1] in arg("set")
+
+    def f_strorder(self, e, arg, bound):
+        return S.str_order(arg("str1"), arg("str2"), arg("order"))
+
+    def f_strmap(self, e, arg, bound):
+        return S.str_map(arg("str"), arg("frommap"), arg("tomap"))
+
+    def f_strtoval(self, e, arg, bound):
+        ref = arg("val")
+        try:
+            value = literal_value(arg("str"), ref.type)
+        except Exception:  # noqa: BLE001 - any text that is not a literal of the type gives FALSE
+            return False
+        ref.set(value)
+        self.changes += 1
+        return True
+
+    def _byte_format(self, arg) -> str:
+        return next((k for k in ("hex", "okt", "bin", "char") if arg(k)), "dec")
+
+    def f_strtobyte(self, e, arg, bound):
+        try:
+            return float(S.str_to_byte(arg("constr"), self._byte_format(arg)))
+        except ValueError as exc:
+            raise self.fail(f"StrToByte: {exc}", e.span, "ERR_ARGVALERR") from None
+
+    def f_bytetostr(self, e, arg, bound):
+        return S.byte_to_str(int(arg("bitdata")), self._byte_format(arg))
+
+    def f_dnumtostr(self, e, arg, bound):
+        return self.string(B.num_to_str(arg("val"), arg("dec"), bool(arg("exp"))), e.span)
+
+    def f_numtodnum(self, e, arg, bound):
+        return arg("value")
+
+    def f_dnumtonum(self, e, arg, bound):
+        v = arg("value")
+        return float(int(v)) if arg("integer") else v
+
+    def f_dectohex(self, e, arg, bound):
+        try:
+            return f"{int(arg('str')):X}"
+        except ValueError:
+            raise self.fail(f"DecToHex: {arg('str')!r} is not a decimal number", e.span, "ERR_ARGVALERR") from None
+
+    def f_hextodec(self, e, arg, bound):
+        try:
+            return str(int(arg("str"), 16))
+        except ValueError:
+            raise self.fail(f"HexToDec: {arg('str')!r} is not a hexadecimal number", e.span, "ERR_ARGVALERR") from None
+
+    def _bits(self, arg, *keys) -> list[int]:
+        return [int(arg(k)) & 0xFF for k in keys]
+
+    def f_bitand(self, e, arg, bound):
+        a, b = self._bits(arg, "bitdata1", "bitdata2")
+        return float(a & b)
+
+    def f_bitor(self, e, arg, bound):
+        a, b = self._bits(arg, "bitdata1", "bitdata2")
+        return float(a | b)
+
+    def f_bitxor(self, e, arg, bound):
+        a, b = self._bits(arg, "bitdata1", "bitdata2")
+        return float(a ^ b)
+
+    def f_bitneg(self, e, arg, bound):
+        return float(~int(arg("bitdata")) & 0xFF)
+
+    def f_bitlsh(self, e, arg, bound):
+        return float((int(arg("bitdata")) << int(arg("shiftsteps"))) & 0xFF)
+
+    def f_bitrsh(self, e, arg, bound):
+        return float((int(arg("bitdata")) & 0xFF) >> int(arg("shiftsteps")))
+
+
+def literal_value(text: str, t: str) -> object:
+    """A RAPID literal (`12.5`, `TRUE`, `"abc"`, `[1,2,3]`) as a value of type `t` (StrToVal)."""
+    from .parser import Parser
+    from .lexer import lex
+
+    p = Parser(lex(text, "<StrToVal>"), text, "<StrToVal>")
+    e = p.expression()
+    if p.tok.kind.name != "EOF":
+        raise ValueError(text)
+
+    def value(x: n.Expr) -> object:
+        if isinstance(x, (n.NumLit, n.StrLit, n.BoolLit)):
+            return x.value
+        if isinstance(x, n.Unary) and x.op in "+-" and isinstance(x.operand, n.NumLit):
+            return -x.operand.value if x.op == "-" else x.operand.value
+        if isinstance(x, n.Aggregate):
+            return Aggregate(value(i) for i in x.items)
+        raise ValueError(text)
+    return coerce(value(e), t)
+
+
+def _unit(v: list[float]) -> list[float] | None:
+    norm = math.sqrt(sum(c * c for c in v))
+    return [c / norm for c in v] if norm > 1e-9 else None
+
+
+def _quat_from_axes(x, y, z) -> list[float]:
+    """The quaternion [q1..q4] of the rotation whose columns are the axes x, y, z."""
+    m00, m10, m20 = x
+    m01, m11, m21 = y
+    m02, m12, m22 = z
+    tr = m00 + m11 + m22
+    if tr > 0:
+        s = math.sqrt(tr + 1.0) * 2
+        q = [0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s]
+    elif m00 > m11 and m00 > m22:
+        s = math.sqrt(1.0 + m00 - m11 - m22) * 2
+        q = [(m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s]
+    elif m11 > m22:
+        s = math.sqrt(1.0 + m11 - m00 - m22) * 2
+        q = [(m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s]
+    else:
+        s = math.sqrt(1.0 + m22 - m00 - m11) * 2
+        q = [(m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s]
+    if q[0] < 0:
+        q = [-c for c in q]
+    return q
+
+
+def _pose_record(p) -> Record:
+    t, q = p
+    return record("pose", [B._clean(c) for c in t], [B._clean(c) for c in q])
