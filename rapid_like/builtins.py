@@ -128,6 +128,10 @@ def predefined_data() -> dict[str, tuple[str, object]]:
     data["long_jmp_all_err"] = ("errnum", LONG_JMP_ALL_ERR)
     data["wait_max"] = ("num", WAIT_MAX)
     data["stempty"] = ("string", "")
+    data["str_digit"] = ("string", "0123456789")
+    data["str_upper"] = ("string", "ABCDEFGHIJKLMNOPQRSTUVWXYZ")
+    data["str_lower"] = ("string", "abcdefghijklmnopqrstuvwxyz")
+    data["str_white"] = ("string", " \t\n\r\v\f")
     for group in _ENUMS.values():
         for name, (t, v) in group.items():
             data[name.lower()] = (t, float(v))

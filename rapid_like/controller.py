@@ -185,59 +185,60 @@ class Controller:
         return True  # signal, motion: re-evaluate on every tick
 
     def _run(self) -> None:
-        try:
-            if self._gen is None:
-                self.interp.init_data(keep_pers=self._started)
-                self._started = True
-                self._gen = self.interp.run(self.entry)
-            self.interp.interrupts.poll()
-            if self.wait is not None and not self._ready(self.wait):
-                self.state = WAITING
-                self.interp.suspensions += 1
-                return
-            self.interp.spins = 0  # a new tick: a new loop budget
-            while True:
-                self.wait = None
-                w = next(self._gen)
-                if w.kind == "step" and self.step_ns:
-                    w.at = self.now + self.step_ns
-                self.wait = w
-                if w.kind == "stop":
-                    self.state, self.end_reason = STOPPED, "stop"
+        while True:
+            try:
+                if self._gen is None:
+                    self.interp.init_data(keep_pers=self._started)
+                    self._started = True
+                    self._gen = self.interp.run(self.entry)
+                self.interp.interrupts.poll()
+                if self.wait is not None and not self._ready(self.wait):
+                    self.state = WAITING
+                    self.interp.suspensions += 1
                     return
-                if w.kind in ("time", "poll", "io") and self._ready(w):
+                self.interp.spins = 0  # a new tick: a new loop budget
+                while True:
+                    self.wait = None
+                    w = next(self._gen)
+                    if w.kind == "step" and self.step_ns:
+                        w.at = self.now + self.step_ns
+                    self.wait = w
+                    if w.kind == "stop":
+                        self.state, self.end_reason = STOPPED, "stop"
+                        return
+                    if w.kind in ("time", "poll", "io") and self._ready(w):
+                        continue
+                    self.state = WAITING
+                    self.interp.suspensions += 1
+                    return
+            except StopIteration:
+                if self._next_cycle():
                     continue
-                self.state = WAITING
-                self.interp.suspensions += 1
-                return
-        except StopIteration:
-            if self._next_cycle():
-                return
-            self.state, self.end_reason = COMPLETED, "completed"
-        except ExitCycleSignal:
-            if self._next_cycle():
-                return
-            self.state, self.end_reason = COMPLETED, "exit_cycle"
-        except ExitSignal:
-            self.state, self.end_reason = COMPLETED, "exit"
-        except (Fatal, Propagate) as e:
-            self._fail(e.error)
-        except ExecError as e:
-            self._fail(e)
-        except RecursionError:
-            self._fail(ExecError("routine calls nested too deeply (endless recursion?)", None, 0))
-        self._gen = None if self.state == ERROR else self._gen
-        if self.state in (COMPLETED, ERROR):
-            self.interp.close_sockets()
+                self.state, self.end_reason = COMPLETED, "completed"
+            except ExitCycleSignal:
+                if self._next_cycle():
+                    continue
+                self.state, self.end_reason = COMPLETED, "exit_cycle"
+            except ExitSignal:
+                self.state, self.end_reason = COMPLETED, "exit"
+            except (Fatal, Propagate) as e:
+                self._fail(e.error)
+            except ExecError as e:
+                self._fail(e)
+            except RecursionError:
+                self._fail(ExecError("routine calls nested too deeply (endless recursion?)", None, 0))
+            self._gen = None if self.state == ERROR else self._gen
+            if self.state in (COMPLETED, ERROR):
+                self.interp.close_sockets()
+            return
 
     def _next_cycle(self) -> bool:
-        """Start the entry routine again (data keep their values) when cycles remain."""
+        """Start the entry routine again, at once (data keep their values), when cycles remain."""
         self.cycle += 1
         if self.cycle >= self.cycles:
             return False
         self._gen = self.interp.run(self.entry)
-        self.wait = Wait("step", self.now + (self.step_ns or 0), "the next cycle")
-        self.state = WAITING
+        self.wait = None
         return True
 
     def _fail(self, err: ExecError) -> None:

@@ -67,8 +67,10 @@ class SocketsMixin:
                 return
             if deadline is not None and self.now >= deadline:
                 raise self.fail(f"{what}: no answer within \\Time", s.span, "ERR_SOCK_TIMEOUT")
-            if self.io_wall_wait:
-                select.select([] if write else [st_sock], [st_sock] if write else [], [], self.io_wall_wait)
+            if self.io_wall_wait:  # give the peer a moment of wall time before simulated time moves on
+                r, w, _ = select.select([] if write else [st_sock], [st_sock] if write else [], [], self.io_wall_wait)
+                if r or w:
+                    return
             at = self.now + to_ns(min(IO_POLL * 2 ** min(turns, 7), 1.0))
             turns += 1
             if deadline is not None:

@@ -19,7 +19,7 @@ from . import builtins as B
 from . import nodes as n
 from . import strings as S
 from .runtime import ExitCycleSignal, Frame, Ref, Wait, to_ns
-from .values import (Aggregate, Opaque, RawBytes, Record, coerce, fmt_num, format_value, pos, record, xyz)
+from .values import (json_num, Aggregate, Opaque, RawBytes, Record, coerce, fmt_num, format_value, pos, record, xyz)
 
 SYSINFO = {"serialno": "rapid_like-0001", "swversion": "rapid_like", "robottype": "simulated robot",
            "ctrlid": "rapid_like", "lanip": "127.0.0.1", "ctrllang": "en", "systemname": "rapid_like"}
@@ -48,7 +48,8 @@ class SystemMixin:
         raise self.fail(f"{what}: no answer within \\MaxTime", s.span, "ERR_TP_MAXTIME")
 
     def _dialog_event(self, instr: str, text: str, answer: object) -> None:
-        self.emit({"type": "dialog", "instr": instr, "text": text, "answer": answer})
+        self.emit({"type": "dialog", "instr": instr, "text": text,
+                   "answer": json_num(answer) if isinstance(answer, float) else answer})
 
     def i_tpreadfk(self, s, arg, text, bound):
         keys = [arg(f"tpfk{i}") for i in range(1, 6)]
