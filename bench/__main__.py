@@ -12,6 +12,7 @@ BENCHMARKS = {
     "modbus": "bench.modbus_latency",  # twin serve vs bare pymodbus: latency, throughput, late steps
     "cell": "bench.cell",  # the full cycle: the PLC in process vs across Modbus/TCP, lockstep
     "campaign": "bench.campaign",  # scenarios/min and parallel efficiency, local pool vs Dask on loopback
+    "rapid": "bench.rapid_polling",  # RAPID polling loops offline: wall time per simulated second
 }
 
 

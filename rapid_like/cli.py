@@ -207,7 +207,13 @@ def main(argv: list[str] | None = None) -> int:
             from .controller import Controller
             from .host import InMemoryHost
             checker = check(program, {s.name.lower(): s for s in signals}, infer_signals=infer)
-            Controller(program, InMemoryHost(signals + checker.inferred), args.entry, autostart=False)
+            routines = [r for r in checker.task.routines if not r.local]
+            if args.entry != "main" or any(r.key == "main" for r in routines):
+                Controller(program, InMemoryHost(signals + checker.inferred), args.entry, autostart=False)
+            else:  # a library module: fine to check, but no task can start from it alone
+                span = checker.task.span
+                checker.warnings.insert(0, (span, "no routine main: the task cannot start from these modules "
+                                                  "(add the module with main, or give --entry)"))
             for span, message in checker.warnings:
                 print(f"{span.file}:{span.line}:{span.col}: warning: {message}", file=out)
             return EX_OK

@@ -43,7 +43,7 @@ from .errors import CheckError, ExecError, RapidError
 from .host import Host
 from .interpreter import NS, ExitCycleSignal, ExitSignal, Fatal, Interpreter, Propagate, Wait, to_ns
 from .parser import parse
-from .runtime import DEFAULT_LOOP_BUDGET  # time-less loop iterations per tick
+from .runtime import DEFAULT_LOOP_BUDGET, POLL_BUDGET  # time-less loop iterations per tick
 
 RUNNING, WAITING, STOPPED, COMPLETED, ERROR = "running", "waiting", "stopped", "completed", "error"
 
@@ -196,7 +196,11 @@ class Controller:
                     self.state = WAITING
                     self.interp.suspensions += 1
                     return
-                self.interp.spins = 0  # a new tick: a new loop budget
+                # a new tick: a new loop budget, a small one for a loop that used up the last tick's
+                polling = self.wait is not None and self.wait.kind == "step"
+                self.interp.spins = 0
+                self.interp.tick_budget = min(self.interp.loop_budget, POLL_BUDGET) if polling else \
+                    self.interp.loop_budget
                 while True:
                     self.wait = None
                     w = next(self._gen)

@@ -158,6 +158,8 @@ class InstructionsMixin:
             if p.mode == "INOUT":
                 self.changes += 1  # the instruction may change the variable
                 return self.lvalue(a.value, f)  # type: ignore[arg-type]
+            if p.type == "any":
+                return self.eval(a.value, f)  # type: ignore[arg-type]
             return self.coerce(self.eval(a.value, f), p.type, a.value.span)  # type: ignore[union-attr]
 
         def text(name: str, default: str = "") -> str:

@@ -9,7 +9,9 @@ was not suspended costs one unit of the tick's *loop budget* (`loop_budget`, 10 
 the controller resets `spins` at every tick). While the budget lasts the loop runs on at the same
 instant, so `FOR i FROM 1 TO 1000` ends at the time it started; when it is used up the loop yields a
 "step" wait and goes on at the next tick. `WHILE TRUE DO ENDWHILE` thus hands control back every
-tick instead of hanging the cell.
+tick instead of hanging the cell. A loop that used up a whole tick's budget is a polling loop: at
+the following ticks, until it waits or ends, it gets `POLL_BUDGET` (100) iterations per tick, which
+bounds what a busy polling loop costs in wall time per simulated second (`python -m bench rapid`).
 
 Errors and ERROR handlers: every statement runs inside a guard. A runtime error (ExecError) in a
 statement of routine R transfers control to R's ERROR handler with ERRNO set; the handler's RETRY
@@ -73,6 +75,7 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         self.suspensions = 0  # bumped by the controller each time the program stays suspended over a tick
         self.loop_budget = max(1, int(loop_budget))  # time-less loop iterations per tick
         self.spins = 0  # time-less loop iterations in this tick (reset by the controller every tick)
+        self.tick_budget = self.loop_budget  # this tick's: POLL_BUDGET for a loop that used up a whole tick
         # Bumped by everything that changes the program's state or the world (assignments, loop
         # variables, INOUT arguments, ERRNO, events) or depends on the time (ClkRead): a tick that
         # leaves it unchanged and ends at the same loop would do the same again at the next tick.
@@ -216,7 +219,7 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         """A loop iteration that consumed no time: one unit of the tick's loop budget; when the
         budget is used up, wait for the next tick (`span` names the loop)."""
         self.spins += 1
-        if self.spins >= self.loop_budget:
+        if self.spins >= self.tick_budget:
             yield Wait("step", what=what, span=span)
 
     # ---- routines -------------------------------------------------------------------------------

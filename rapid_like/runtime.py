@@ -12,6 +12,9 @@ from .values import RECORDS, array_type, base_type, split_array_type
 
 NS = 1_000_000_000
 DEFAULT_LOOP_BUDGET = 10_000  # time-less loop iterations per tick (Controller, Interpreter)
+# Iterations per tick for a loop that already used up a whole tick's budget without waiting: a
+# polling loop. It bounds the wall time a busy polling loop costs per simulated second.
+POLL_BUDGET = 100
 
 
 def to_ns(seconds: float) -> int:

@@ -33,7 +33,7 @@ from twin.core.signals import BOOL, FLOAT, INPUT, INT, OUTPUT, SignalSpec
 from twin.core.station import ControllerSpec
 
 from .builtins import ERRORS
-from .controller import ERROR, RUNNING, WAITING, Controller, load_program
+from .controller import ERROR, RUNNING, WAITING, Controller, load_program, load_task
 from .errors import ExecError
 from .host import MotionRequest, SignalInfo
 from .values import Record, record
@@ -273,7 +273,9 @@ def attach_controller(twin, on_event: Callable[[dict], None] | None = None, auto
         raise TwinError(f"station {twin.station.name!r} has no [controller]")
     check_wiring(twin, spec)
     host = TwinHost(twin, spec)
-    controller = Controller(load_program(spec.program), host, entry=entry or spec.entry, on_event=on_event,
-                            autostart=autostart, loop_budget=STATION_LOOP_BUDGET)
+    program = load_task([spec.program, *spec.modules]) if spec.modules else load_program(spec.program)
+    controller = Controller(program, host, entry=entry or spec.entry, on_event=on_event, autostart=autostart,
+                            loop_budget=STATION_LOOP_BUDGET, answers=list(spec.answers))
+    controller.interp.io_wall_wait = 0.0  # a socket wait never stalls the simulation step
     twin.add_device(ControllerDevice(host, controller))
     return controller

@@ -176,3 +176,40 @@ def test_a_gripper_plc_that_does_not_answer_stops_the_cycle_with_a_clear_message
         assert printed[-1] == "The gripper PLC did not answer the finger preparation request within 30 s"
         assert twin.read("doCycleFault") and not twin.read("fullAutoRun") and not twin.read("doPrepare")
         assert twin.read("L2") == pytest.approx(0.35)  # nobody moved the fingers
+
+
+STATION_DATA = """MODULE station_data(SYSMODULE)
+  PERS tooldata tLong := [TRUE,[[0,0,450],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
+  PERS wobjdata wPallet := [FALSE,TRUE,"",[[1600,-800,150],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];
+ENDMODULE
+"""
+USES_STATION_DATA = """MODULE UsesData
+  CONST robtarget pAbove := [[0,0,500],[0,1,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PERS num height := 0;
+  PROC main()
+    TPReadNum height, "Height above the pallet?";
+    MoveL Offs(pAbove, 0, 0, height), v1000, fine, tLong\\WObj:=wPallet;
+  ENDPROC
+ENDMODULE
+"""
+
+
+def test_a_station_controller_lists_several_modules_and_answers_its_dialogs(tmp_path):
+    station = copy_rig(tmp_path)
+    (station / "uses_data.mod").write_text(USES_STATION_DATA)
+    (station / "station_data.sys").write_text(STATION_DATA)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace('program = "ring_rig.mod"',
+                                             'program = "uses_data.mod"\nmodules = ["station_data.sys"]\n'
+                                             'answers = ["100"]')
+                    .replace('entry = "Init"', 'entry = "main"'))
+    with open_cell(station) as twin:
+        run_until(twin, lambda: twin.controller.state == "completed", 20.0)
+        # the answer raised the target 100 mm: the long tool's TCP 600 mm above the pallet's top, the flange 450 mm more
+        assert twin.tcp_pose().position == pytest.approx((1.6, -0.8, 0.15 + 0.6 + 0.1), abs=0.001)
+
+
+def test_a_missing_module_of_the_station_controller_names_the_key(tmp_path):
+    station = copy_rig(tmp_path, 'program = "ring_rig.mod"', 'program = "ring_rig.mod"\nmodules = ["nope.sys"]')
+    with pytest.raises(StationError, match=r"controller\.modules\[0\]: file 'nope.sys' not found"):
+        open_cell(station)

@@ -117,6 +117,8 @@ class ControllerSpec:
     program: Path
     entry: str
     io: tuple[IOSignal, ...]
+    modules: tuple[Path, ...] = ()  # more modules of the task (system modules, station data)
+    answers: tuple[str, ...] = ()  # answers to the program's FlexPendant dialogs, in order
 
 
 @dataclass(frozen=True)
@@ -404,7 +406,15 @@ def load_station(path: str | Path) -> Station:
                 raise r.error("source", f"only an input (DI, AI, GI) can read a twin output; {sig.name} is {sig.type}")
             r.done()
             io.append(sig)
-        controller = ControllerSpec(cr.path_to("program"), cr.get("entry", str, "main"), tuple(io))
+        modules = []
+        for i, text in enumerate(cr.get("modules", list, [])):
+            path = (file.parent / str(text)).resolve()
+            if not path.is_file():
+                raise cr.error(f"modules[{i}]", f"file {text!r} not found (looked at {path})")
+            modules.append(path)
+        answers = tuple(str(a) for a in cr.get("answers", list, []))
+        controller = ControllerSpec(cr.path_to("program"), cr.get("entry", str, "main"), tuple(io), tuple(modules),
+                                    answers)
         cr.done()
     watchdog = None
     wr = top.sub("watchdog", required=False)
