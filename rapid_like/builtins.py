@@ -304,6 +304,19 @@ _INSTRUCTIONS = {
     "CopyRawBytes": r"rawbytes FromRawData, num FromIndex, INOUT rawbytes ToRawData, num ToIndex, \num NoOfBytes",
     "BitSet": "INOUT byte BitData, num BitPos",
     "BitClear": "INOUT byte BitData, num BitPos",
+    "Open": r"string Object, \string File, INOUT iodev IODevice, \switch Read | switch Write | switch Append "
+            r"| switch Bin",
+    "Close": "INOUT iodev IODevice",
+    "Rewind": "INOUT iodev IODevice",
+    "Write": r"iodev IODevice, string String, \num Num | bool Bool | pos Pos | orient Orient | dnum Dnum, "
+             r"\switch NoNewLine",
+    "PDispOn": r"\switch Rot, \robtarget ExeP, robtarget ProgPoint, tooldata Tool, \wobjdata WObj",
+    "EOffsSet": "extjoint EAxOffs",
+    "EOffsOn": r"\extjoint ExeP, robtarget ProgPoint",
+    "WaitSyncTask": r"\switch InPos, syncident SyncID, tasks{} TaskList, \num TimeOut",
+    "SearchL": r"\switch Stop | switch PStop | switch SStop | switch Sup, signaldi Signal, \switch Flanks, "
+               r"INOUT robtarget SearchPoint, robtarget ToPoint, \num ID, speeddata Speed, \num V | num T, "
+               r"tooldata Tool, \wobjdata WObj, \loaddata TLoad",
     "SpyStart": "string File",
     "SpyStop": "",
     "BookErrNo": "INOUT errnum ErrorName",
@@ -396,6 +409,10 @@ _FUNCTIONS = {
     "SocketGetStatus": ("socketdev Socket", "socketstatus"),
     "RawBytesLen": ("rawbytes RawData", "num"),
     "TestAndSet": ("INOUT bool Object", "bool"),
+    "ReadStr": (r"iodev IODevice, \string Delim, \switch RemoveCR, \switch DiscardHeaders, \num Time", "string"),
+    "ReadNum": (r"iodev IODevice, \string Delim, \num Time", "num"),
+    "IsFile": (r"string Path, \switch Directory | switch Fifo | switch RegFile | switch BlockSpec "
+               r"| switch CharSpec", "bool"),
     "UIMessageBox": (r"\string Header, \string Message | string{} MsgArray, \switch Wrap, \num Buttons | "
                      r"string{} BtnArray, \num DefaultBtn, \num Icon, \string Image, " + _UI_BREAK, "btnres"),
     "UINumEntry": (r"\string Header, \string Message | string{} MsgArray, \switch Wrap, \num Icon, "

@@ -49,6 +49,13 @@ _APPROXIMATE = {
     "pdispoff": "program displacement is not applied to the motions",
     "eoffsoff": "external axes are not simulated",
     "ierror": "error interrupts never fire in simulation",
+    "pdispon": "program displacement is not applied to the motions",
+    "eoffson": "external axes are not simulated",
+    "eoffsset": "external axes are not simulated",
+    "waitsynctask": "one task runs: WaitSyncTask does not wait for the others",
+    "searchl": "the search moves to ToPoint; it hits when the signal is 1 at the start or at the end of the "
+               "motion (SearchPoint := ToPoint), else ERR_WHLSEARCH",
+    "write": "written files go to the trace (type file), not to disk",
     "spystart": "no spy log is written",
     "waitrob": "motions end in position, so WaitRob never waits",
 }
@@ -146,6 +153,15 @@ class Checker:
             info = self.infer_signal(name, _SIGNAL_PREFIXES[name[:2].lower()])
             return Sym("signal", "num", "CONST", info)
         return None
+
+    def may_be_signal(self, name: str, scope: dict[str, Sym]) -> bool:
+        """Without an I/O configuration, may an undeclared name used as a value be a digital input? Not
+        when it is a routine, a RAPID name, or a near miss of a declared name (a misspelling)."""
+        key = name.lower()
+        if key in self.routines or key in B.FUNCTIONS or key in B.INSTRUCTIONS or rapid_names.kind_of(key):
+            return False
+        declared = [k for k in self.all_names(scope) if k not in self.signals]
+        return not difflib.get_close_matches(key, declared, n=1, cutoff=0.75)
 
     def infer_signal(self, name: str, kind: str, span: Span | None = None) -> SignalInfo:
         info = SignalInfo(name, kind)
@@ -544,12 +560,13 @@ class Checker:
             zone = next((a for a in s.args if a.value is not None and not a.optional and a.value.text.lower() in
                          B.zone_names()), None)
             if any(a.optional and a.key == "conc" for a in s.args):
-                self.warn(s.span, f"{word} \\Conc: the program goes on at once; with a station the motion "
-                                  f"still runs to its end point (no blending)")
+                self.warn(s.span, f"{word} \\Conc: the program goes on at once and the next motion waits for "
+                                  f"this one; offline every motion ends at once")
             if zone is not None and zone.value.text.lower() != "fine":
-                self.warn(zone.span, f"{word} with zone {zone.value.text}: the program goes on when the robot "
-                                     f"is within the zone; the corner is not rounded (the path runs through "
-                                     f"the point)")
+                self.warn(zone.span, f"{word} with zone {zone.value.text}: in a station the program goes on when "
+                                     f"the TCP is within the zone and the next motion starts from there (the "
+                                     f"corner is cut from rest, not blended at speed; a MoveAbsJ stops at its "
+                                     f"point); offline every motion ends at once")
 
     def signal_arg(self, name: str, p: n.Param, e: n.Expr, scope: dict[str, Sym]) -> None:
         want = SIGNAL_TYPES[p.type]
@@ -623,6 +640,9 @@ class Checker:
             return "aggregate"
         if isinstance(e, n.Name):
             sym = self.lookup(e.name, scope)
+            if sym is None and self.infer and self.may_be_signal(e.name, scope):
+                self.infer_signal(e.name, "DI", e.span)
+                sym = self.lookup(e.name, scope)
             if sym is None:
                 if e.key in self.routines or e.key in B.FUNCTIONS:
                     raise self.err(f"{e.name} is a routine, not a value (a function call needs "
@@ -646,6 +666,9 @@ class Checker:
                                f"{len(e.indices)} ind{'ices' if len(e.indices) > 1 else 'ex'} given",
                                e.indices[0].span)
             return elem
+        if isinstance(e, (n.Component, n.Index)) and isinstance(e.obj, n.Name) and \
+                self.lookup(e.obj.name, scope) is None and e.obj.key not in self.routines:
+            raise self.undefined(e.obj.name, e.obj.span, scope)  # a record or an array, never a signal
         if isinstance(e, n.Component):
             t = self.value_type(e.obj, scope)
             if t is None:
@@ -701,8 +724,11 @@ class Checker:
             self.operand(e.right, rt, "string", "string +")
             return "string"
         if op in ("+", "-") and (lb == "pos" or rb == "pos"):
-            self.operand(e.left, lt, "pos", f"pos {op}")
-            self.operand(e.right, rt, "pos", f"pos {op}")
+            for side, t in ((e.left, lt), (e.right, rt)):
+                if t == "aggregate":
+                    self.expect_type(side, "pos", scope)  # `p + [0, 0, 100]`: the aggregate is a pos
+                else:
+                    self.operand(side, t, "pos", f"pos {op}")
             return "pos"
         if op == "*" and (lb in ("pos", "orient") or rb in ("pos", "orient")):
             if lb == "orient" or rb == "orient":

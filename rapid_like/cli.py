@@ -214,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
                 span = checker.task.span
                 checker.warnings.insert(0, (span, "no routine main: the task cannot start from these modules "
                                                   "(add the module with main, or give --entry)"))
-            for span, message in checker.warnings:
+            for span, message in sorted(checker.warnings, key=lambda w: (w[0].file, w[0].line, w[0].col)):
                 print(f"{span.file}:{span.line}:{span.col}: warning: {message}", file=out)
             return EX_OK
 
@@ -233,6 +233,11 @@ def main(argv: list[str] | None = None) -> int:
         report(e)
         return EX_DATAERR
     out.flush()
+    if outcome.reason == "blocked":
+        what, span = outcome.waiting
+        where = f"{span.file}:{span.line}:{span.col}" if span else first
+        print(f"{where}: note: {what} waits for an input that nothing drives; the run ends here at "
+              f"{outcome.t:g} s (configure the I/O with --io and give --set to go on)", file=err)
     if outcome.error is not None:
         report(outcome.error)
         return EX_SOFTWARE

@@ -408,13 +408,22 @@ class InstructionsMixin:
             ev["via"] = _target_json(via)
         ev.update(speed=req.speed_name, zone=req.zone_name, tool=req.tool_name, wobj=req.wobj_name)
         self.emit(ev)
+        while self.concurrent is not None and not self.host.motion_done(self.concurrent):  # a \\Conc one first
+            yield from self.pause(Wait("motion", None, f"{instr} {req.target_name} after the \\Conc motion", s.span))
         handle = self.host.start_motion(req)
         self.active_tool, self.active_wobj = req.tool, req.wobj
         if arg("conc"):  # \Conc: the program goes on at once, the motion runs on
             self.concurrent = handle
             return
         self.concurrent = None
+        zone = req.zone.fields
+        in_zone = getattr(self.host, "motion_in_zone", None)
+        radius = float(zone["pzone_tcp"]) if not zone["finep"] else 0.0
+        if arg("z") is not None:  # \Z: the zone size in mm, instead of the zonedata's
+            radius = float(arg("z"))
         while not self.host.motion_done(handle):
+            if radius > 0 and in_zone is not None and in_zone(handle, radius):
+                break  # a zone: the program goes on as the robot enters it
             yield from self.pause(Wait("motion", None, f"{instr} {req.target_name}", s.span))
 
     def i_movej(self, s, arg, text, bound):

@@ -65,6 +65,7 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         self.interrupts = InterruptTable(self)
         self.sockets: list = []
         self.stop_move = False
+        self.files: dict[str, str] = {}  # files the program wrote (Open ... \\Write; Write), by path
         self.concurrent = None  # the handle of a \\Conc motion still running
         self.predefined = {k: Cell(t, v, "CONST", k) for k, (t, v) in B.predefined_data().items()}
         self.active_tool = self.predefined["tool0"].value
@@ -605,6 +606,10 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         raise self.fail(f"unknown operator {op}", e.op_span)  # pragma: no cover
 
     def record_arith(self, op: str, a: object, b: object, e: n.Binary) -> object:
+        if isinstance(a, Aggregate) and isinstance(b, Record) and b.type == "pos":
+            a = self.coerce(a, "pos", e.left.span)
+        if isinstance(b, Aggregate) and isinstance(a, Record) and a.type == "pos":
+            b = self.coerce(b, "pos", e.right.span)
         ta = a.type if isinstance(a, Record) else describe_type(a)
         tb = b.type if isinstance(b, Record) else describe_type(b)
         if op in ("+", "-") and ta == tb == "pos":

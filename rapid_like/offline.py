@@ -11,6 +11,11 @@ input changes, so the runner skips straight to the next `--set`, pulse edge or t
 
 `--set` changes at time T are applied before the program runs at T.
 
+Without an I/O configuration (`infer_signals`: the signals are the program's own guesses) nothing
+drives the inputs, so a wait that nothing scheduled can end ends the run, reason "blocked" (the
+trace names the wait and its line): a dry run up to where the program waits for the cell. With an
+I/O configuration it is the runtime error "waits forever".
+
 Pulses outlive the program. On a real controller the I/O system times a PulseDO, so a pulse that
 is still running when the program ends (completes, EXITs, executes Stop, or fails with a runtime
 error) still ends at its time and the output goes back to where it was; a pending SetDO \\SDelay
@@ -44,11 +49,12 @@ class SignalChange:
 
 @dataclass
 class Outcome:
-    reason: str  # completed, exit, stop, time_limit, error
+    reason: str  # completed, exit, exit_cycle, stop, time_limit, blocked, error
     t: float
     error: ExecError | None = None
     host: InMemoryHost | None = None
     events: list[dict] = field(default_factory=list)
+    waiting: tuple = ()  # blocked: (what it waits for, its Span)
 
 
 DEFAULT_TIME_LIMIT = 3600.0
@@ -114,6 +120,11 @@ def run_offline(module: n.Module | n.Task, signals: list[SignalInfo], changes: l
                 break
             w = ctl.wait
             what = w.what if w else "the program"
+            if infer_signals:  # no I/O configuration: nothing drives the inputs, the dry run ends here
+                ctl.now = now
+                emit({"t": round(now / NS, 6), "type": "end", "reason": "blocked", "waiting": what,
+                      "line": w.span.line if w and w.span else 0})
+                return Outcome("blocked", now / NS, None, host, events, (what, w.span if w else None))
             err = ExecError(f"{what} waits forever: nothing scheduled can change what it waits for "
                             f"(give a --set for it, or --max-time)", w.span if w else None, 0)
             ctl.now = now

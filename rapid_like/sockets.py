@@ -2,11 +2,12 @@
 SocketAccept, SocketSend, SocketReceive, SocketClose and SocketGetStatus, as a mixin of the evaluator.
 
 Sockets are the operating system's, non-blocking. An instruction that has to wait for the peer
-(connect, accept, receive) checks its socket, and when nothing is there yet waits 10 ms of simulated
-time (`IO_POLL`), each such turn also waiting up to `io_wall_wait` seconds of wall time for the peer
-(10 ms offline; a station sets 0 so the simulation never stalls). So simulated and wall time run
-about together while a program waits on a socket, and a peer on the same machine (a test server on
-loopback, a vision system's simulator) is served promptly. \\Time (60 s by default, WAIT_MAX for
+(connect, accept, receive) checks its socket, and when nothing is there yet waits up to
+`io_wall_wait` seconds of wall time for the peer (10 ms offline; a station sets 0 so the simulation
+never stalls), then lets 10 ms of simulated time pass (`IO_POLL`). So offline, simulated time keeps
+pace with the wall clock while a program waits on a socket (`--max-time 20` gives a client about 20
+s), and a peer on the same machine (a test client on loopback, a vision system's simulator) is
+served promptly. \\Time (60 s by default, WAIT_MAX for
 ever) is counted in simulated time; when it runs out the error is ERR_SOCK_TIMEOUT. A peer that
 closes the connection, or one that refuses it, is ERR_SOCK_CLOSED.
 
@@ -56,23 +57,20 @@ class SocketsMixin:
         return st.sock
 
     def _io_wait(self, st_sock: socket.socket, s, what: str, deadline: int | None, write: bool = False):
-        """Wait (a generator) until the socket is readable (writable), or raise ERR_SOCK_TIMEOUT. The
-        simulated time between two looks doubles from 10 ms up to 1 s while nothing comes (the wall time
-        waited per look stays `io_wall_wait`), so a server waiting for a client that never comes costs
-        little."""
-        turns = 0
+        """Wait (a generator) until the socket is readable (writable), or raise ERR_SOCK_TIMEOUT. Each
+        look waits up to `io_wall_wait` s of wall time for the peer, then lets 10 ms of simulated time
+        pass: offline, simulated time keeps pace with the wall clock while a program waits on a socket."""
         while True:
             r, w, _ = select.select([] if write else [st_sock], [st_sock] if write else [], [], 0)
             if r or w:
                 return
             if deadline is not None and self.now >= deadline:
                 raise self.fail(f"{what}: no answer within \\Time", s.span, "ERR_SOCK_TIMEOUT")
-            if self.io_wall_wait:  # give the peer a moment of wall time before simulated time moves on
+            if self.io_wall_wait:  # the peer has wall time: simulated time keeps pace with it while waiting
                 r, w, _ = select.select([] if write else [st_sock], [st_sock] if write else [], [], self.io_wall_wait)
                 if r or w:
                     return
-            at = self.now + to_ns(min(IO_POLL * 2 ** min(turns, 7), 1.0))
-            turns += 1
+            at = self.now + to_ns(IO_POLL)
             if deadline is not None:
                 at = min(at, deadline)
             yield from self.pause(Wait("io", at, what, s.span))

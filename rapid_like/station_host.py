@@ -88,6 +88,7 @@ class TwinHost:
         self.outputs: dict[str, float] = {s.name: 0.0 for s in spec.io if s.drives}
         self.printed: list[str] = []
         self._motion = 0
+        self._zone_target = None  # (tool, target position in m) of the running Cartesian motion
         self._active: tuple[Record | None, Record | None] = (None, None)  # tooldata, wobjdata of the last motion
 
     # -- signals --------------------------------------------------------------------------------------
@@ -127,6 +128,7 @@ class TwinHost:
         v_ori = math.radians(float(speed["v_ori"]))
         name = request.target_name or request.instr
         tool = _tframe(request.tool)
+        self._zone_target = None
         try:
             if request.instr == "MoveAbsJ":
                 q = [math.radians(float(v)) for v in request.target.fields["robax"].values()]
@@ -136,6 +138,7 @@ class TwinHost:
                 target = frame * _pose(request.target)
                 via = frame * _pose(request.via) if request.via is not None else None
                 twin.move(request.instr, target, v_tcp, v_ori=v_ori, via=via, name=name, tool=tool)
+                self._zone_target = (tool, target.position)
         except MotionError as exc:
             raise HostError(str(exc), "ERR_ROBLIMIT") from None
         self._active = (request.tool, request.wobj)
@@ -144,6 +147,16 @@ class TwinHost:
 
     def motion_done(self, handle: object) -> bool:
         return handle != self._motion or not self.twin.robot_busy
+
+    def motion_in_zone(self, handle: object, radius_mm: float) -> bool:
+        """Is the TCP of a Cartesian motion within `radius_mm` of its target (or the motion over)? A
+        program moving with a zone goes on from there, and its next motion starts from where the robot
+        is: the corner is cut. A MoveAbsJ is a stop point."""
+        if self.motion_done(handle) or self._zone_target is None:
+            return self.motion_done(handle)
+        tool, goal = self._zone_target
+        here = self.twin.tcp_pose(tool).position
+        return math.dist([float(v) for v in here], [float(v) for v in goal]) * 1000.0 <= radius_mm
 
     def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
         """CRobT: the TCP of `tool` in `wobj`; without them, those of the last motion (the active ones), or

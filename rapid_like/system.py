@@ -286,6 +286,107 @@ class SystemMixin:
     i_clearpath = i_storepath = i_restopath = i_singarea = i_cirpathmode = i_pathresol = _accept
     i_gripload = i_worldacclim = i_pathacclim = i_pdispoff = i_pdispset = i_eoffsoff = _accept
 
+    i_pdispon = i_eoffsset = i_eoffson = i_waitsynctask = _accept
+
+    def i_searchl(self, s, arg, text, bound):
+        """SearchL, approximately: the robot moves to ToPoint; the search hits when the signal is 1 at
+        the start or at the end of the motion (SearchPoint := ToPoint), else ERR_WHLSEARCH."""
+        sig = arg("signal")
+        hit = self.host.read_signal(sig.name) == 1
+        yield from self._move(s, arg, text, bound, "MoveL")
+        hit = hit or self.host.read_signal(sig.name) == 1
+        if not hit:
+            raise self.fail(f"SearchL: {sig.name} did not change during the search", s.span, "ERR_WHLSEARCH")
+        arg("searchpoint").set(arg("topoint"))
+
+    # ---- files (iodev): written files go to the trace, read ones come from disk -----------------------
+    def _path(self, arg) -> str:
+        obj, name = arg("object"), arg("file")
+        return f"{obj.rstrip('/')}/{name}" if name else obj
+
+    def i_open(self, s, arg, text, bound):
+        path = self._path(arg)
+        dev = arg("iodevice").get()
+        if arg("read"):
+            local = path.split(":", 1)[1].lstrip("/") if ":" in path[:12] else path
+            written = self.files.get(path)
+            try:
+                content = written if written is not None else open(local, encoding="latin-1").read()
+            except OSError:
+                raise self.fail(f"Open {path}: no such file to read", s.span, "ERR_FILEOPEN") from None
+            dev.state = {"path": path, "mode": "read", "data": content, "pos": 0}
+        else:
+            if not arg("append"):
+                self.files[path] = ""
+            self.files.setdefault(path, "")
+            dev.state = {"path": path, "mode": "write", "data": "", "pos": 0}
+        yield from ()
+
+    def _dev(self, arg, s, mode: str) -> dict:
+        dev = arg("iodevice")
+        dev = dev.get() if hasattr(dev, "get") else dev
+        st = dev.state
+        if not isinstance(st, dict) or st.get("mode") is None:
+            raise self.fail("the I/O device is not open (Open it first)", s.span, "ERR_FILEACC")
+        if st["mode"] != mode:
+            raise self.fail(f"the file {st['path']} is open for {st['mode']}ing", s.span, "ERR_FILEACC")
+        return st
+
+    def i_write(self, s, arg, text, bound):
+        st = self._dev(arg, s, "write")
+        out = arg("string")
+        for k in ("num", "bool", "pos", "orient", "dnum"):
+            v = arg(k)
+            if v is not None:
+                out += format_value(v)
+        if not arg("nonewline"):
+            out += "\n"
+        self.files[st["path"]] = self.files.get(st["path"], "") + out
+        self.emit({"type": "file", "file": st["path"], "text": out})
+        yield from ()
+
+    def i_close(self, s, arg, text, bound):
+        arg("iodevice").get().state = None
+        yield from ()
+
+    def i_rewind(self, s, arg, text, bound):
+        st = arg("iodevice").get().state
+        if isinstance(st, dict):
+            st["pos"] = 0
+        yield from ()
+
+    def f_readstr(self, e, arg, bound):
+        st = self._dev(arg, e, "read")
+        data, i = st["data"], st["pos"]
+        if i >= len(data):
+            return "EOF"
+        j = data.find("\n", i)
+        j = len(data) if j < 0 else j
+        delim = arg("delim")
+        if delim:
+            k = S.str_find(data[i:j], 1, delim) - 1 + i
+            j = min(j, k)
+        line = data[i:j]
+        st["pos"] = j + 1
+        if arg("removecr"):
+            line = line.rstrip("\r")
+        return line[:80]
+
+    def f_readnum(self, e, arg, bound):
+        text = self.f_readstr(e, arg, bound)
+        if text == "EOF":
+            return 9.998e36  # the manual's EOF_NUM
+        try:
+            return float(text.strip().split()[0])
+        except (ValueError, IndexError):
+            raise self.fail(f"ReadNum: {text!r} is not a number", e.span, "ERR_RCVDATA") from None
+
+    def f_isfile(self, e, arg, bound):
+        import os
+        path = arg("path")
+        local = path.split(":", 1)[1].lstrip("/") if ":" in path[:12] else path
+        return path in self.files or os.path.exists(local)
+
     # ---- group and analog waits --------------------------------------------------------------------
     def _compare(self, arg):
         value = arg("value")

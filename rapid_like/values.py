@@ -22,7 +22,7 @@ NUMERIC = {"num", "dnum", "errnum", "intnum", "dionum", "byte", "errdomain", "er
 # Types whose values the program can only hold and pass on (no components, no literals); their
 # default value is an `Opaque` the instructions that use them fill in.
 OPAQUE_TYPES = {"socketdev", "rawbytes", "iodev", "triggdata", "wzstationary", "wztemporary", "shapedata",
-                "mecunit", "restartdata", "syncident", "tasks", "dir", "datapos", "pathrecid", "btnvalue"}
+                "mecunit", "restartdata", "syncident", "dir", "datapos", "pathrecid", "btnvalue"}
 ATOMIC = NUMERIC | {BOOL, STRING}
 SIGNAL_TYPES = {"signaldi": "DI", "signaldo": "DO", "signalai": "AI", "signalao": "AO",
                 "signalgi": "GI", "signalgo": "GO"}
@@ -50,6 +50,8 @@ RECORDS: dict[str, list[tuple[str, str]]] = {
                       ("followtime", _N), ("signal", STRING), ("relation", _N), ("checkvalue", _N)],
     "wobjdata": [("robhold", BOOL), ("ufprog", BOOL), ("ufmec", STRING), ("uframe", "pose"),
                  ("oframe", "pose")],
+    "tasks": [("taskname", STRING)],
+    "listitem": [("image", STRING), ("text", STRING)],
 }
 BUILTIN_RECORDS = frozenset(RECORDS)
 KNOWN_TYPES = ATOMIC | set(RECORDS) | set(SIGNAL_TYPES) | {"clock"} | OPAQUE_TYPES | {"errstr", "stringdig"}

@@ -150,3 +150,53 @@ def test_help_documents_pulses_that_outlive_the_program(capsys):
         main(["run", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "after the edges of any PulseDO still running when the program ended" in text
+
+
+WAITS_FOR_A_PART = """MODULE Cell
+  PROC main()
+    SetDO doClamp, 1;
+    WaitDI diPart, 1;
+    TPWrite "part";
+  ENDPROC
+ENDMODULE
+"""
+
+
+def test_without_io_a_wait_nothing_drives_ends_the_dry_run_and_says_where(tmp_path: Path):
+    p = tmp_path / "cell.mod"
+    p.write_text(WAITS_FOR_A_PART)
+    code, out, err = run_cli(["run", str(p), "--trace"])
+    assert code == 0
+    ev = [json.loads(x) for x in out.splitlines()]
+    assert ev == [{"t": 0.0, "type": "DO", "signal": "doClamp", "value": 1},
+                  {"t": 0.0, "type": "end", "reason": "blocked", "waiting": "WaitDI diPart", "line": 4}]
+    assert err.startswith(f"{p}:4:5: note: WaitDI diPart waits for an input that nothing drives")
+    # with an I/O configuration the same wait is an error: the user said what drives the inputs
+    code, out, err = run_cli(["run", str(p), "--io", "DO:doClamp,DI:diPart"])
+    assert code == 70 and "waits forever" in err
+
+
+def test_task_dir_runs_a_robotstudio_backup_with_its_calibration_module(tmp_path: Path):
+    progmod = tmp_path / "RAPID" / "TASK1" / "PROGMOD"
+    progmod.mkdir(parents=True)
+    (progmod / "CalibData.mod").write_text(
+        "MODULE CalibData\n  PERS tooldata tGrip:=[TRUE,[[0,0,100],[1,0,0,0]],[1,[0,0,1],[1,0,0,0],0,0,0]];\nENDMODULE\n")
+    (progmod / "Module1.mod").write_text(
+        "MODULE Module1\n  CONST robtarget p1:=[[500,0,400],[0,0,1,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+        "  PROC main()\n    MoveL p1,v100,fine,tGrip;\n    TPWrite \"at \" \\Num:=CRobT(\\Tool:=tool0).trans.z;\n"
+        "  ENDPROC\nENDMODULE\n")
+    code, out, err = run_cli(["run", "--task", str(tmp_path / "RAPID" / "TASK1")])
+    assert (code, err) == (0, "")
+    assert out == "at 500\n"  # the flange is 100 mm above the TCP of tGrip, which points down
+
+
+def test_check_lists_what_is_approximate_with_file_and_line(tmp_path: Path):
+    p = tmp_path / "zones.mod"
+    p.write_text("MODULE Z\n  PROC main()\n    VelSet 50, 800;\n    MoveL CRobT(), v100, z10, tool0;\n"
+                 "    MoveL CRobT(), v100, fine, tool0 \\Conc;\n  ENDPROC\nENDMODULE\n")
+    code, out, err = run_cli(["check", str(p)])
+    assert (code, err) == (0, "")
+    lines = out.splitlines()
+    assert lines[0].startswith(f"{p}:3:5: warning: VelSet: ")
+    assert lines[1].startswith(f"{p}:4:26: warning: MoveL with zone z10: ")
+    assert lines[2].startswith(f"{p}:5:5: warning: MoveL \\Conc: ")

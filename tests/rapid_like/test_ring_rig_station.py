@@ -213,3 +213,35 @@ def test_a_missing_module_of_the_station_controller_names_the_key(tmp_path):
     station = copy_rig(tmp_path, 'program = "ring_rig.mod"', 'program = "ring_rig.mod"\nmodules = ["nope.sys"]')
     with pytest.raises(StationError, match=r"controller\.modules\[0\]: file 'nope.sys' not found"):
         open_cell(station)
+
+
+ZONES = """MODULE Zones
+  PERS tooldata tLong := [TRUE,[[0,0,450],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
+  PERS wobjdata wPallet := [FALSE,TRUE,"",[[1600,-800,150],[1,0,0,0]],[[0,0,0],[1,0,0,0]]];
+  CONST robtarget pAbove := [[0,0,500],[0,1,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PERS robtarget pAt := [[0,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PROC main()
+    MoveL pAbove, v1000, fine, tLong\\WObj:=wPallet;
+    MoveL Offs(pAbove, 200, 0, 0), v200, {zone}, tLong\\WObj:=wPallet;
+    pAt := CRobT(\\Tool:=tLong\\WObj:=wPallet);
+    MoveL Offs(pAbove, 200, 200, 0), v200, fine, tLong\\WObj:=wPallet;
+  ENDPROC
+ENDMODULE
+"""
+
+
+@pytest.mark.parametrize("zone, low, high", [("z50", 150.0, 199.0), ("fine", 199.5, 200.5)])
+def test_a_zone_lets_the_program_go_on_as_the_robot_enters_it_and_fine_stops_at_the_point(tmp_path, zone, low,
+                                                                                         high):
+    station = copy_rig(tmp_path)
+    (station / "zones.mod").write_text(ZONES.replace("{zone}", zone))
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace('program = "ring_rig.mod"', 'program = "zones.mod"')
+                    .replace('entry = "Init"', 'entry = "main"'))
+    with open_cell(station) as twin:
+        run_until(twin, lambda: twin.controller.state == "completed", 30.0)
+        at = twin.controller.interp.globals["pat"].value.fields["trans"]
+        # the program read the robot's position on its way to x = 200 mm: within z50's 50 mm of the point (a
+        # step of 12 ms at 200 mm/s is 2.4 mm), or at the point for fine
+        assert low <= float(at.fields["x"]) <= high
+        assert twin.tcp_pose().position[1] == pytest.approx(-0.8 + 0.2, abs=0.001)  # then on to the last point
