@@ -47,84 +47,68 @@ def counters(raw: Raw) -> tuple[int, int]:
     return words[0] << 16 | words[1], words[4] << 16 | words[5]
 
 
-def test_a_flooding_client_leaves_the_simulation_and_the_other_clients_their_turn():
-    with ServerProcess(RING_BENCH) as server, Raw(server.port) as other:
-        flooder = subprocess.Popen([sys.executable, __file__, str(server.port), "4.0"], stdout=subprocess.PIPE,
-                                   text=True, preexec_fn=lambda: os.nice(10))
-        try:
-            time.sleep(0.5)  # the flood is on
-            step0, late0 = counters(other)
-            t0 = time.monotonic()
-            latencies = []
-            while time.monotonic() - t0 < 3.0:
-                t1 = time.perf_counter()
-                assert other.request(pdu(3, 16, 1))[:2] == b"\x03\x02"
-                latencies.append(time.perf_counter() - t1)
-                time.sleep(0.005)
-            step1, late1 = counters(other)
-            wall = time.monotonic() - t0
-            out, _ = flooder.communicate(timeout=30)
-        finally:
-            if flooder.poll() is None:
-                flooder.kill()
-                flooder.wait()
+def measure(server: ServerProcess, other: Raw, flood_cmd: list[str]) -> dict:
+    """Run `flood_cmd` (niced: what is measured is the server's own fairness, not the OS giving the
+    flooder the server's core) while `other` polls every 5 ms: its latency, the steps and late steps."""
+    from modbus_helpers import ROOT
+
+    flooder = subprocess.Popen(flood_cmd, stdout=subprocess.PIPE, text=True, cwd=ROOT, preexec_fn=lambda: os.nice(10))
+    try:
+        time.sleep(0.6)  # the flood is on
+        step0, late0 = counters(other)
+        t0 = time.monotonic()
+        latencies = []
+        while time.monotonic() - t0 < 2.5:
+            t1 = time.perf_counter()
+            assert other.request(pdu(3, 16, 1))[:2] == b"\x03\x02"
+            latencies.append(time.perf_counter() - t1)
+            time.sleep(0.005)
+        step1, late1 = counters(other)
+        wall = time.monotonic() - t0
+        out, _ = flooder.communicate(timeout=30)
+    finally:
+        if flooder.poll() is None:
+            flooder.kill()
+            flooder.wait()
     assert flooder.returncode == 0
-    answered = int(out)
     latencies.sort()
-    p50, p99 = statistics.median(latencies), latencies[int(0.99 * (len(latencies) - 1))]
-    steps, late = step1 - step0, late1 - late0
-    report = (f"flood: {answered} requests answered; the other client: p50 {p50 * 1e3:.1f} ms, "
-              f"p99 {p99 * 1e3:.1f} ms; {steps} steps in {wall:.2f} s ({late} late)")
-    assert answered > 2000, report  # the flood itself was served (less while the simulation runs late)
+    r = {"answered": int(out), "p50": statistics.median(latencies), "p99": latencies[int(0.99 * (len(latencies) - 1))],
+         "steps": step1 - step0, "late": late1 - late0, "wall": wall}
+    r["report"] = (f"{r['answered']} flood requests answered; the poller: p50 {r['p50'] * 1e3:.1f} ms, "
+                   f"p99 {r['p99'] * 1e3:.1f} ms; {r['steps']} steps in {wall:.2f} s ({r['late']} late)")
+    return r
+
+
+def twice(flood_cmd: list[str], ok) -> None:
+    """Measure; on a shared machine whose load spoiled the first try, once more (both reports if both fail)."""
+    reports = []
+    with ServerProcess(RING_BENCH) as server, Raw(server.port) as other:
+        for _ in range(2):
+            r = measure(server, other, [c.replace("PORT", str(server.port)) for c in flood_cmd])
+            reports.append(r["report"])
+            if ok(r):
+                return
+    raise AssertionError("; ".join(reports))
+
+
+def test_a_flooding_client_leaves_the_simulation_and_the_other_clients_their_turn():
     # Unfair (a whole socket read answered in one callback): p50 ~130 ms, 15 % of the steps, all late.
-    assert p50 < 0.030 and p99 < 0.200, report
-    assert steps > 0.5 * wall / 0.012, report  # the ring bench's step: 12 ms
-
-
-if __name__ == "__main__":
-    flood(int(sys.argv[1]), float(sys.argv[2]))
+    twice([sys.executable, __file__, "PORT", "3.5"],
+          lambda r: (r["answered"] > 2000  # the flood itself was served (less while the simulation runs late)
+                     and r["p50"] < 0.030 and r["p99"] < 0.200 and r["steps"] > 0.5 * r["wall"] / 0.012))
 
 
 def test_forty_flooding_connections_leave_the_simulation_its_steps_and_a_poller_its_latency():
     """The issue's case: 40 connections pipelining flat out (in one other process) while one client polls.
-    Before the global budget: 81 % of the steps late. The benchmark (`python -m bench modbus`) reports the
-    figures (and `test_fair_share.py` checks the sharing itself, deterministically); here margins wide enough
-    for a 2-core machine shared with other work (the flood runs niced, so what is measured is the server's
-    own fairness, not the OS giving the flooder the server's core)."""
-    import os
+    Before the global budget: 81 % of the steps late on a quiet machine, all of them on a busy one. The
+    benchmark (`python -m bench modbus`) reports the figures and `test_fair_share.py` checks the sharing
+    itself, deterministically; a loaded machine makes some steps late whatever the server does (the process
+    waits for a core), so here the margins are wide: the simulation keeps real time on average (it catches
+    up) and the poller is answered."""
+    twice([sys.executable, "-m", "bench.flood", "PORT", "40", "3.5"],
+          lambda r: (r["answered"] > 2000 and r["late"] <= 0.6 * r["steps"]
+                     and r["steps"] > 0.75 * r["wall"] / 0.012 and r["p99"] < 0.200))
 
-    from modbus_helpers import ROOT
 
-    with ServerProcess(RING_BENCH) as server, Raw(server.port) as other:
-        flooder = subprocess.Popen([sys.executable, "-m", "bench.flood", str(server.port), "40", "4.0"],
-                                   stdout=subprocess.PIPE, text=True, cwd=ROOT, preexec_fn=lambda: os.nice(10))
-        try:
-            time.sleep(0.7)  # the flood is on
-            step0, late0 = counters(other)
-            t0 = time.monotonic()
-            latencies = []
-            while time.monotonic() - t0 < 2.5:
-                t1 = time.perf_counter()
-                assert other.request(pdu(3, 16, 1))[:2] == b"\x03\x02"
-                latencies.append(time.perf_counter() - t1)
-                time.sleep(0.005)
-            step1, late1 = counters(other)
-            wall = time.monotonic() - t0
-            out, _ = flooder.communicate(timeout=30)
-        finally:
-            if flooder.poll() is None:
-                flooder.kill()
-                flooder.wait()
-    answered = int(out)
-    latencies.sort()
-    p99 = latencies[int(0.99 * (len(latencies) - 1))]
-    steps, late = step1 - step0, late1 - late0
-    report = (f"40 flooding: {answered} answered; poller p50 {statistics.median(latencies) * 1e3:.1f} ms, "
-              f"p99 {p99 * 1e3:.1f} ms; {steps} steps in {wall:.2f} s ({late} late)")
-    assert answered > 2000, report  # the flood itself was served (less while the simulation runs late)
-    # Unfair (before the global budget): 81 % of the steps late on a quiet machine, all of them on a busy one.
-    # A loaded machine makes some steps late whatever the server does (the process waits for a core), so
-    # the margin is wide; the simulation still keeps real time on average (it catches up).
-    assert late <= 0.6 * steps, report
-    assert steps > 0.75 * wall / 0.012, report
-    assert p99 < 0.200, report
+if __name__ == "__main__":
+    flood(int(sys.argv[1]), float(sys.argv[2]))

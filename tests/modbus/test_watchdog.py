@@ -3,6 +3,7 @@ puts the gripper in the station's safe state and raises comm.lost; the next requ
 client's heartbeat keeps a quiet but healthy PLC from being taken for lost."""
 from __future__ import annotations
 
+import functools
 import struct
 import time
 from pathlib import Path
@@ -148,6 +149,7 @@ def comm_lost(raw: Raw, address: int) -> int:
     return raw.request(pdu(2, address, 1))[2] & 1
 
 
+@functools.lru_cache(maxsize=None)
 def map_address(name: str) -> int:
     import json
     import subprocess

@@ -36,6 +36,7 @@ class TwinBridge:
         self.twin, self.map, self.log = twin, rmap, log
         self.runner = None  # set by whoever paces the twin (twin.pacing): mode, speed, late_steps, remaining
         self.fault = False
+        self._encoded: dict[int, tuple[object, list[int]]] = {}  # id(entry): the map outlives it
         self.extra_status: dict[str, object] = {}  # values of sim.* entries the server's owner knows (comm.watchdog_ms)
         self._queue: list[Sequence[tuple[Entry, object]]] = []
         self._sizes = {t: rmap.size(t) for t in (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)}
@@ -150,9 +151,13 @@ class TwinBridge:
                 images[table] = bytes(img)
             else:
                 words = [0] * size
+                encoded = self._encoded  # entry -> (value, words): most values do not change from step to step
                 for e in entries:
                     v = read(e.signal) if e.signal is not None else status.get(e.name, 0)
-                    words[e.address:e.end] = e.encode(v)
+                    last = encoded.get(id(e))
+                    if last is None or last[0] != v or type(last[0]) is not type(v):
+                        last = encoded[id(e)] = (v, e.encode(v))
+                    words[e.address:e.end] = last[1]
                 images[table] = struct.pack(f">{size}H", *words)
         self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
         for batch in self._queue:  # written but not yet applied (empty after a step): still reads as written
