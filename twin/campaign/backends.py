@@ -16,6 +16,7 @@ Both call `on_result(index, envelope)` as results come; an envelope is {"measure
 """
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import pickle
@@ -24,6 +25,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import types
 from collections.abc import Callable, Iterable
 from multiprocessing.connection import wait
 from pathlib import Path
@@ -73,7 +75,8 @@ class _ForkJob:
         self.log = log
         self.reader, writer = ctx.Pipe(duplex=False)
         self.proc = ctx.Process(target=child_main, args=(campaign, index, writer, log), daemon=True)
-        self.proc.start()
+        with _without_main_module():
+            self.proc.start()
         writer.close()
         self.envelope: dict | None = None
         self.eof = False
@@ -144,6 +147,19 @@ class _SpawnJob:
                 os.unlink(p)
             except OSError:
                 pass
+
+
+@contextlib.contextmanager
+def _without_main_module():
+    """multiprocessing re-imports the parent's main module in every child it starts (pytest's, a Dask
+    worker's: seconds each); a scenario process needs only `twin.campaign.worker`, so it is told of no
+    main module."""
+    main = sys.modules.get("__main__")
+    sys.modules["__main__"] = types.ModuleType("__main__")
+    try:
+        yield
+    finally:
+        sys.modules["__main__"] = main
 
 
 def _may_fork() -> bool:
