@@ -154,3 +154,24 @@ def test_a_lost_link_trips_the_comm_loss_watchdog_and_the_plc_recovers(tmp_path)
     assert healthy["comm_lost_trips"] == 0 and cut["comm_lost_trips"] == 1
     # the grip waited for the link, then completed
     assert cut["outcome"] == "completed" and cut["grips"] == 1 and cut["time"] > 1.2 > healthy["time"]
+
+
+def test_drive_limits_and_the_simulation_step_are_parameters(tmp_path):
+    body = """
+    [[scenarios]]
+    gripper.effort = 400.0
+    plc.threshold = 600.0
+    [[scenarios]]
+    gripper.velocity_mm_s = 5.0
+    sim.step = 0.006
+    """
+    head = HEAD.replace('done_when = "gripped"\n', 'done_when = "gripped and time >= 1.0"\n')
+    c = load_campaign(write(tmp_path, body, head=head))
+    weak, fine = run_scenario(c, 0), run_scenario(c, 1)
+    # drives limited to 400 N press with 400 N at most: a PLC waiting for 600 N never confirms, it declares a miss
+    assert weak["max_finger_force"] == pytest.approx(400.0, rel=0.01)
+    assert (weak["outcome"], weak["fault"], weak["grip"]) == ("stopped", "missed", "missed")
+    # a 6 ms step: twice the steps for the same simulated time; fingers at 5 mm/s take 2 s for their 10 mm
+    assert fine["outcome"] == "completed"
+    assert fine["steps"] == pytest.approx(fine["time"] / 0.006, abs=1)
+    assert fine["time"] == pytest.approx(10.0 / 5.0, abs=0.2)
