@@ -15,7 +15,9 @@ Then, once:
   - `open`: every axis goes to its open setpoint (`[watchdog] open = { L2 = 0.35 }`, else the station's
     `gripper.initial`, else it stops where it is).
 
-The first request afterwards (from any source) clears `comm.lost` (its answer still shows the state of
+In lockstep, requests that only write or read `sim.advance` (a script driving simulated time and
+waiting for its steps) arm the watchdog but do not feed or clear it. The first other request afterwards
+(from any source) clears `comm.lost` (its answer still shows the state of
 the last completed step, so a client reading `comm.lost` sees the 1 once); the safe setpoints stay until a
 client writes new ones.
 
@@ -78,9 +80,17 @@ class Watchdog:
         return self.twin.time if self.twin is not None else 0.0
 
     # -- the front ends' side -------------------------------------------------------------------------
-    def feed(self, source: str) -> None:
-        """A request came from `source` (e.g. "modbus 10.0.0.5:50312"): the link is alive."""
+    def feed(self, source: str, clock_only: bool = False) -> None:
+        """A request came from `source` (e.g. "modbus 10.0.0.5:50312"): the link is alive.
+
+        `clock_only`: in lockstep, a request that only drives or polls simulated time (`sim.advance`) is
+        the test harness's clock, not the controller's traffic: it arms the watchdog but neither feeds nor
+        clears it, so a script that advances and waits for the steps sees the watchdog fire."""
         t = self.now()
+        if clock_only:
+            if self.last is None:
+                self.last, self.last_source = t, source
+            return
         self.last_seen[source] = t
         if self.lost:
             self.lost = False

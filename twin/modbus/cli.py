@@ -355,7 +355,7 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
         if not lockstep:
             watchdog.clock = runner.clock  # real time: the wall clock; lockstep: simulated time
         bridge.extra_status["comm.watchdog_ms"] = round((watchdog.timeout or 0) * 1000)
-        on_request = lambda peer: watchdog.feed(f"modbus {peer}")  # noqa: E731
+        on_request = lambda peer, clock_only: watchdog.feed(f"modbus {peer}", clock_only=lockstep and clock_only)  # noqa: E731
     bridge.publish()
     server = ModbusServer(rmap, bridge, unit_id=unit_id, frame_timeout=frame_timeout,
                           requests_per_step=get("requests_per_step", REQUESTS_PER_STEP),

@@ -215,6 +215,15 @@ class PduHandler:
             return bytes((fc | 0x80, result))
         return result
 
+    def clock_only(self, pdu: bytes) -> bool:
+        """The request only reads or writes sim.advance (holding register 0): a lockstep harness driving
+        and waiting for simulated time, not a controller's traffic (see twin.watchdog)."""
+        adv = self.map.by_name.get("sim.advance")
+        if adv is None or len(pdu) < 5 or pdu[0] not in (3, 6, 16):
+            return False
+        address, second = _AQ.unpack_from(pdu, 1)
+        return address == adv.address and (pdu[0] == 6 or second == 1)
+
     # -- reads ----------------------------------------------------------------------------------------
     def _read_bits(self, pdu: bytes):
         if len(pdu) != 5:

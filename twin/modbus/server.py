@@ -128,7 +128,7 @@ class ModbusServer:
                  serve_share: float = SERVE_SHARE, max_connections: int = MAX_CONNECTIONS,
                  idle_timeout: float | None = None, allow: Iterable | None = None, read_only: bool = False,
                  gaps_zero: bool = False, identity: DeviceIdentity | None = None,
-                 on_request: Callable[[str], None] | None = None, behind: Callable[[], bool] | None = None,
+                 on_request: Callable[[str, bool], None] | None = None, behind: Callable[[], bool] | None = None,
                  log: Callable[[str], None] = _log, clock: Callable[[], float] = time.perf_counter):
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
         self.units = {unit_id, 0, 255}
@@ -270,7 +270,7 @@ class ModbusServer:
             budget -= n
             self._used += n
             if n and self.on_request is not None:
-                self.on_request(conn.peer)
+                self.on_request(conn.peer, conn.clock_only)
             if conn.has_request() and not conn.closed and not conn.writing_paused:
                 backlog.append(conn)
                 conn.queued = True
@@ -297,6 +297,7 @@ class _Connection(asyncio.Protocol):
         self.writing_paused = False
         self.reading_paused = False
         self.queued = False
+        self.clock_only = False
         self.waiting = False  # a deferred answer (function 23 with sim.advance in lockstep) is pending
         self.closed = False
         self.admitted = False
@@ -423,6 +424,8 @@ class _Connection(asyncio.Protocol):
         handle = self.server.handle
         count = 0
         bad = ""
+        clock = self.server.pdus.clock_only
+        self.clock_only = True  # every request answered this turn only touched sim.advance (lockstep time)
         while count < limit and n - pos >= 7:
             tid, pid, length, unit = _HDR.unpack_from(buf, pos)
             if pid != 0:
@@ -433,7 +436,10 @@ class _Connection(asyncio.Protocol):
                 break
             if n - pos < 6 + length:
                 break
-            response = handle(unit, bytes(buf[pos + 7:pos + 6 + length]))
+            request = bytes(buf[pos + 7:pos + 6 + length])
+            if self.clock_only and not clock(request):
+                self.clock_only = False
+            response = handle(unit, request)
             pos += 6 + length
             count += 1
             if isinstance(response, Deferred):  # answered once the lockstep steps are done; later ones wait
