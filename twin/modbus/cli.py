@@ -133,6 +133,9 @@ def add_commands(subparsers) -> None:
     from twin.view.live import add_serve_options  # --view [PORT], --record FILE (twin.view, twin.recording)
 
     add_serve_options(p)
+    from twin.opcua.serve import add_arguments as add_opcua_arguments  # --opcua [PORT], --no-modbus, --opcua-*
+
+    add_opcua_arguments(p)
     p.set_defaults(func=cmd_serve, lockstep=False)
 
     p = subparsers.add_parser("map", help="print the Modbus register map of a station",
@@ -217,6 +220,11 @@ def cmd_serve(args) -> int:
     from . import log as serve_log
 
     serve_log.setup(args.log_level)
+    from twin.opcua.serve import check_arguments as check_opcua_arguments
+
+    if (problem := check_opcua_arguments(args)) is not None:
+        print(f"twin serve: error: {problem}", file=sys.stderr)
+        return 2
     stop = asyncio.Event()
     signals = _StartUpSignals(stop)  # first thing: loading the station (pybullet) takes a while
     twin = None
@@ -343,7 +351,13 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
         except (NotImplementedError, RuntimeError, ValueError):  # not the main thread, or Windows
             pass
     bridge = TwinBridge(twin, rmap)
-    runner = LockstepRunner(bridge.step) if lockstep else RealtimeRunner(bridge.step, twin.dt, speed)
+    opcua = None
+    if get("opcua", None) is not None:  # OPC UA on the same cell: the bridge's step, then its publication
+        from twin.opcua.cell_link import CellLink
+
+        opcua = CellLink(twin, bridge)
+    step = opcua.step if opcua is not None else bridge.step
+    runner = LockstepRunner(step) if lockstep else RealtimeRunner(step, twin.dt, speed)
     bridge.runner = runner
     watchdog = getattr(twin, "watchdog", None)
     on_request = None
@@ -373,7 +387,7 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
         serve_profile(server, profile, bridge, unit_id=profile_unit, map_unit_id=unit_id)
     listening = []
     try:
-        if not get("tls_only", False):
+        if not get("tls_only", False) and not get("no_modbus", False):
             listening.append(("", *await server.start(host, port)))
         if tls is not None:
             tls_port = get("tls_port", TLS_PORT)
@@ -399,6 +413,17 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
 
     start_front_ends = serve_front_ends(opt)
     stop_front_ends = start_front_ends(twin, bridge, runner, rmap) if start_front_ends is not None else None
+    ua_server = None
+    if opcua is not None:
+        from twin.opcua.serve import options_from, start_opcua_logged
+
+        opcua.runner = runner
+        ua_server = await start_opcua_logged(opcua, **options_from(opt))
+        if ua_server is None:
+            if stop_front_ends is not None:
+                stop_front_ends()
+            await server.close()
+            return 2
     task = asyncio.ensure_future(runner.run())
     stopper = asyncio.ensure_future(stop.wait())
     await asyncio.wait({task, stopper}, return_when=asyncio.FIRST_COMPLETED)
@@ -410,6 +435,8 @@ async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_i
     await server.close()
     if stop_front_ends is not None:
         stop_front_ends()
+    if ua_server is not None:
+        await ua_server.close()
     for t in (task, stopper):
         if not t.done():
             t.cancel()

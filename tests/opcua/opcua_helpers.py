@@ -1,0 +1,57 @@
+"""A `twin serve STATION --opcua 0` subprocess, and asyncua client helpers."""
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import threading
+
+from asyncua import Client, ua
+
+from modbus_helpers import ROOT, ServerProcess
+
+RING_RIG = ROOT / "stations" / "ring_rig"
+NAMESPACE = "urn:gripper-twin:station:"
+FOLDERS = ("Gripper", "Fingers", "Robot", "Targets", "Controller", "Sim")
+
+
+class OpcUaServerProcess(ServerProcess):
+    """`twin serve STATION --port 0 --opcua 0 ARGS...`; `url` is the OPC UA endpoint, `port` Modbus's (if served)."""
+
+    def __init__(self, station, *args: str, cert_dir=None):
+        extra = ["--opcua-cert-dir", str(cert_dir)] if cert_dir is not None else []
+        self.cmd = [sys.executable, "-m", "twin", "serve", str(station), "--port", "0", "--opcua", "0", *extra, *args]
+        env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+        if cert_dir is None:
+            env["XDG_DATA_HOME"] = str(ROOT / ".pytest_cache" / "opcua-certs")
+        self.proc = subprocess.Popen(self.cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                     cwd=ROOT, env=env)
+        self.lines: list[str] = []
+        self._seen = threading.Condition()
+        threading.Thread(target=self._drain, daemon=True).start()
+        self.url = self.wait_for(r"OPC UA listening on (\S+)", timeout=60).group(1)
+        m = re.search(r"listening on ([\d.]+):(\d+)", "\n".join(self.lines))
+        self.host, self.port = (m.group(1), int(m.group(2))) if m else ("127.0.0.1", None)
+
+
+async def namespace(client: Client, station: str = "ring_rig") -> int:
+    return await client.get_namespace_index(NAMESPACE + station)
+
+
+def node(client: Client, ns: int, name: str):
+    return client.get_node(ua.NodeId(name, ns))
+
+
+async def advance(client: Client, ns: int, steps: int) -> int:
+    """Sim.Advance(steps): returns sim.step once the steps are done."""
+    sim = node(client, ns, "Sim")
+    return await sim.call_method(ua.NodeId("Sim.Advance", ns), ua.Variant(steps, ua.VariantType.UInt32))
+
+
+async def write_status(n, value, vtype=None) -> str:
+    """Write one value; the name of the status code the server answered ('Good' when accepted)."""
+    dv = ua.DataValue(ua.Variant(value, vtype) if vtype is not None else ua.Variant(value))
+    result = await n.session.write(ua.WriteParameters(NodesToWrite=[
+        ua.WriteValue(NodeId=n.nodeid, AttributeId=ua.AttributeIds.Value, Value=dv)]))
+    return result[0].name
