@@ -13,6 +13,7 @@ BENCHMARKS = {
     "cell": "bench.cell",  # the full cycle: the PLC in process vs across Modbus/TCP, lockstep
     "campaign": "bench.campaign",  # scenarios/min and parallel efficiency, local pool vs Dask on loopback
     "rapid": "bench.rapid_polling",  # RAPID polling loops offline: wall time per simulated second
+    "opcua": "bench.opcua",  # OPC UA vs Modbus on the same cell: latency, change delay, 1000 monitored items
 }
 
 

@@ -243,7 +243,8 @@ class OpcUaServer:
     def _set(self, attval, dv: ua.DataValue) -> None:
         attval.value = dv
         for handle, callback in list(attval.datachange_callbacks.items()):
-            _run_now(callback(handle, dv))
+            if not _queue_change(callback, handle, dv):
+                _run_now(callback(handle, dv))
 
     def show_written(self, var: Variable, value) -> None:
         """An accepted write reads back at once (as Modbus shows written coils and registers)."""
@@ -453,6 +454,39 @@ def _answer_calls_concurrently(iserver) -> None:
 
 
 _CALLS: set = set()  # running method calls (a task needs a reference until it is done)
+
+
+_NO_DEADBAND = (None, ua.DeadbandType.None_)
+
+
+def _queue_change(callback, handle: int, dv: ua.DataValue) -> bool:
+    """asyncua internals, the hot path: queue a changed value for one monitored item of a subscription, as its
+    datachange callback would, without deep-copying the DataValue per item (publish never changes a DataValue
+    it has handed out: it makes a new one per change). False: leave it to asyncua's own callback (an item with
+    a deadband filter, or a version of asyncua this does not know)."""
+    service = getattr(callback, "__self__", None)
+    try:
+        mid = service._monitored_datachange[handle]
+        mdata = service._monitored_items[mid]
+        queues = service.isub._triggered_datachanges
+    except (AttributeError, KeyError):
+        return False
+    flt = mdata.filter
+    if flt is not None and getattr(flt, "DeadbandType", None) not in _NO_DEADBAND:
+        return False
+    if mdata.mode == ua.MonitoringMode.Disabled:
+        return True
+    values = mdata.mvalue
+    values.old_dvalue, values.current_dvalue = values.current_dvalue, dv
+    notification = ua.MonitoredItemNotification(ClientHandle=mdata.client_handle, Value=dv)
+    queue = queues.get(mid)
+    if queue is None:
+        queues[mid] = [notification]
+    else:
+        if mdata.queue_size and len(queue) >= mdata.queue_size:
+            del queue[0]
+        queue.append(notification)
+    return True
 
 
 def _run_now(coro) -> None:
