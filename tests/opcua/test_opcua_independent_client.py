@@ -36,7 +36,9 @@ def test_node_opcua_browses_reads_writes_advances_and_subscribes(node_opcua):
         r = subprocess.run([str(node_opcua), "check.js", server.url, "ring_rig"], cwd=NODE_CLIENT,
                            capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
-    out = json.loads(r.stdout.strip().splitlines()[-1])
+    result = [line for line in r.stdout.splitlines() if line.startswith("RESULT ")]  # node-opcua logs to stdout too
+    assert result, r.stdout + r.stderr
+    out = json.loads(result[-1][len("RESULT "):])
     ns = out["ns"]
     assert ns >= 2
     assert {"Gripper", "Fingers", "Robot", "Targets", "Controller", "Sim"} <= set(out["folders"])

@@ -88,10 +88,8 @@ def test_browse_folders_and_every_signal_is_one_variable_named_by_its_signal(loc
                 ua.AttributeIds.AccessLevel)) for name, (folder, ch) in found.items()}
 
     ns, found = run(main())
-    # every signal Modbus serves is a variable of that name (sim.advance is Sim.Advance; map_crc is Modbus's own)
+    # every signal Modbus serves is a variable of that name, the simulator's own too
     for e in rmap:
-        if e.name in ("sim.advance", "sim.map_crc"):
-            continue
         assert e.name in found, e.name
         folder, vtype, access = found[e.name]
         expected = {"bool": ua.VariantType.Boolean}.get(e.type, ua.VariantType.String if e.choices else None)
@@ -144,7 +142,7 @@ def test_every_signal_reads_as_over_modbus_at_the_same_lockstep_step(lockstep, r
         async def main():
             async with Client(lockstep.url, timeout=60) as c:
                 ns = await namespace(c)
-                names = [e.name for e in rmap if e.name not in ("sim.advance", "sim.map_crc")]
+                names = [e.name for e in rmap]
                 values = await c.read_values([node(c, ns, n) for n in names])
                 return dict(zip(names, values))
 

@@ -27,7 +27,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, OUTPUT, SignalSpec
+from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
 
 from .units import Unit, unit_of
 
@@ -123,26 +123,8 @@ def variable_of(spec: SignalSpec) -> Variable:
                     low, high, spec.description, spec)
 
 
-# The simulator's own signals, for signal tables that do not declare them (the cell publishes their values).
-SIM_SIGNALS: tuple[SignalSpec, ...] = tuple(SignalSpec(name, OUTPUT, t, unit, lo, hi, desc, group="sim") for
-                                            name, t, unit, lo, hi, desc in (
-    ("fault", BOOL, "", None, None, "the simulation stopped on an error (see the server's log); outputs are frozen"),
-    ("sim.lockstep", BOOL, "", None, None, "the server runs in lockstep (steps only through Sim.Advance or sim.advance)"),
-    ("sim.late", BOOL, "", None, None, "real time: the last step finished after its wall-clock deadline"),
-    ("sim.step", INT, "steps", 0, _UINT32[1], "simulation steps completed"),
-    ("sim.time_ms", INT, "ms", 0, _UINT32[1], "simulated time (steps x step length)"),
-    ("sim.late_steps", INT, "steps", 0, _UINT32[1], "real time: steps that finished after their wall-clock deadline"),
-    ("sim.dt_us", INT, "us", 0, 65535, "simulation step length"),
-    ("sim.mode", INT, "", 0, 1, "0 = lockstep, 1 = real time"),
-    ("sim.speed_pct", INT, "%", 0, 65535, "real time: speed in percent of real time (100 = real time); 0 in lockstep"),
-))
-
-
 def build_address_space(signals: Iterable[SignalSpec], station: str) -> AddressSpace:
-    """The address space serving `signals` (the station's table; the simulator's signals added when missing)."""
-    signals = list(signals)
-    if not any(s.group == "sim" for s in signals):
-        signals += SIM_SIGNALS
+    """The address space serving `signals`: the cell's whole table, the simulator's own signals included."""
     reserved = set(FOLDERS) | {ADVANCE_METHOD}
     seen: set[str] = set()
     variables = []

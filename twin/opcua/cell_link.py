@@ -25,6 +25,17 @@ class CellLink:
         self._names = tuple(s.name for s in twin.signals)
         self._waiting: list[tuple[int, asyncio.Future]] = []
 
+    def signals(self) -> tuple:
+        """The cell's signal table as OPC UA serves it: the twin's signals, then the simulator's own entries of the
+        register map (sim.step, sim.lockstep, fault, ...: what the runner and the server publish)."""
+        from twin.core.signals import BOOL, INPUT, INT, OUTPUT, SignalSpec
+
+        own = {s.name for s in self.twin.signals}
+        status = tuple(SignalSpec(e.name, INPUT if e.writable else OUTPUT, BOOL if e.type == "bool" else INT, e.unit,
+                                  e.min, e.max, e.description, group="sim")
+                       for e in self.bridge.map if e.signal is None and e.name not in own)
+        return tuple(self.twin.signals) + status
+
     def attach(self, server) -> None:
         self.server = server
         self.publish()
@@ -32,22 +43,24 @@ class CellLink:
     # -- the runner's side ----------------------------------------------------------------------------
     def step(self) -> bool:
         ok = self.bridge.step()
-        self.publish()
+        self.publish(in_step=True)
         if not ok:
             self._fail_waiting()
         return ok
 
-    def values(self) -> dict[str, object]:
+    def values(self, in_step: bool = False) -> dict[str, object]:
         read = self.twin.read
         values = {name: read(name) for name in self._names}
         values.update(self.bridge._status())
         runner = self.runner
-        values["sim.advance"] = 0 if runner is None else min(0xFFFF, runner.remaining)
+        # the steps still to run (as Modbus reads it): inside a step, the runner still counts the one running
+        remaining = 0 if runner is None else max(0, runner.remaining - (1 if in_step else 0))
+        values["sim.advance"] = min(0xFFFF, remaining)
         return values
 
-    def publish(self) -> None:
+    def publish(self, in_step: bool = False) -> None:
         if self.server is not None:
-            self.server.publish(self.values())
+            self.server.publish(self.values(in_step))
         if self._waiting:
             step = self.twin.step_count
             done = [(n, f) for n, f in self._waiting if step >= n]
@@ -86,4 +99,5 @@ class CellLink:
         fut = asyncio.get_running_loop().create_future()
         self._waiting.append((target, fut))
         runner.request(n)
+        self.publish()  # sim.advance shows the steps to run
         return await fut

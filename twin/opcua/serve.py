@@ -92,7 +92,7 @@ async def start_opcua(link, *, host: str, port: int, security: Security):
     from .server import OpcUaServer
 
     twin = link.twin
-    space = build_address_space(twin.signals, twin.station.name)
+    space = build_address_space(link.signals(), twin.station.name)
     server = OpcUaServer(space, step_s=twin.dt, submit=link.submit, advance=link.advance, security=security)
     try:
         await server.start(host, port)

@@ -58,7 +58,7 @@ async function main() {
     await session.close();
     await client.disconnect();
   }
-  process.stdout.write(JSON.stringify(out) + "\n");
+  process.stdout.write("RESULT " + JSON.stringify(out) + "\n");
 }
 
 main().catch((err) => { process.stderr.write(String(err && err.stack || err) + "\n"); process.exit(1); });
