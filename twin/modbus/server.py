@@ -35,9 +35,10 @@ Wire behaviour
   closes that connection (the next request is never glued onto it).
 - Fairness: all connections share one budget per step period (`requests_per_step` requests, and at
   most `serve_share` of the period's wall time spent answering). Connections with complete requests
-  wait in a round-robin queue; each turn of the event loop answers a few requests of each in turn (a
-  connection that was idle goes before the ones with a backlog), so a client polling one request at a
-  time is answered within about one step period however many others flood the server, and the
+  wait in a round-robin queue; each turn of the event loop answers a few requests of each in turn. A
+  connection that was idle goes before the ones with a backlog, and a tenth of the budget is kept for
+  such connections, so a client polling one request at a time is answered at once however many others
+  flood the server; the
   simulation runner gets the loop between turns. A connection with a backlog is not read further
   (TCP pushes back on its sender) until its backlog is answered. The simulation comes first: while it
   runs late (`behind()`: on a loaded machine the process may not get the CPU it needs), the budget is
@@ -239,11 +240,17 @@ class ModbusServer:
     def want_turn(self, conn: "_Connection", fresh: bool) -> None:
         (self._fresh if fresh else self._backlog).append(conn)
         conn.queued = True
+        loop = asyncio.get_running_loop()
         if self._scheduled is None:
-            self._scheduled = asyncio.get_running_loop().call_soon(self._serve)
+            self._scheduled = loop.call_soon(self._serve)
+        elif fresh and isinstance(self._scheduled, asyncio.TimerHandle):  # waiting for the next period:
+            self._scheduled.cancel()  # an idle client's request may use the reserve now
+            self._scheduled = loop.call_soon(self._serve)
 
     def _serve(self) -> None:
-        """One turn: answer connections round-robin, within this step period's budget."""
+        """One turn: answer connections round-robin, within this step period's budget. Connections with a
+        backlog use the budget less a reserve (a tenth) kept for connections that were idle, so a client
+        asking one request at a time is answered at once however busy the others keep the server."""
         self._scheduled = None
         clock = self.clock
         now = clock()
@@ -251,23 +258,28 @@ class ModbusServer:
             self._window, self._used, self._busy = now, 0, 0.0
             if self.behind is not None:
                 self.scale = max(MIN_SCALE, self.scale * 0.5) if self.behind() else min(1.0, self.scale * 1.25)
-        budget = int(self.requests_per_step * self.scale) - self._used
+        limit = max(2, int(self.requests_per_step * self.scale))
+        backlog_limit = limit - max(1, limit // 10)
         share = self.serve_share * self.scale * self.step_period
-        time_left = min(TURN_SECONDS, share - self._busy)
         t0 = now
         fresh, backlog = self._fresh, self._backlog
         pass_left = quantum = 0
-        while (fresh or backlog) and budget > 0 and clock() - t0 < time_left:
+        while (fresh or backlog) and clock() - t0 < TURN_SECONDS:
+            if fresh:
+                room = limit - self._used
+            else:
+                room = min(backlog_limit - self._used, 1 << 30 if self._busy + clock() - t0 < share else 0)
+            if room <= 0:
+                break
             if pass_left == 0:  # a pass over the waiting connections: the budget left, split evenly
                 pass_left = len(fresh) + len(backlog)
-                quantum = max(1, min(QUANTUM, budget // pass_left))
+                quantum = max(1, min(QUANTUM, room // pass_left))
             pass_left -= 1
             conn = fresh.popleft() if fresh else backlog.popleft()
             conn.queued = False
             if conn.closed or conn.writing_paused:
                 continue
-            n = conn.answer(min(quantum, budget))
-            budget -= n
+            n = conn.answer(min(quantum, room))
             self._used += n
             if n and self.on_request is not None:
                 self.on_request(conn.peer, conn.clock_only)
@@ -277,11 +289,13 @@ class ModbusServer:
         self._busy += clock() - t0
         if fresh or backlog:
             loop = asyncio.get_running_loop()
-            if budget <= 0 or self._busy >= share:
+            more_fresh = fresh and self._used < limit
+            more_backlog = backlog and self._used < backlog_limit and self._busy < share
+            if more_fresh or more_backlog:
+                self._scheduled = loop.call_soon(self._serve)
+            else:
                 delay = max(0.0, self._window + self.step_period - clock())
                 self._scheduled = loop.call_later(delay, self._serve)
-            else:
-                self._scheduled = loop.call_soon(self._serve)
 
 
 class _Connection(asyncio.Protocol):
