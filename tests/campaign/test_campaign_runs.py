@@ -81,6 +81,23 @@ def test_a_failing_expectation_names_the_expectation_and_the_measured_value(tmp_
     assert failures[0].get("message").startswith("cycle_time_max: expected at most 0.3 s, measured 0.")
     xmlschema = pytest.importorskip("xmlschema")
     xmlschema.XMLSchema(DATA / "junit.xsd").validate(tmp_path / "junit.xml")
+    # each failing scenario re-run with a recording (every signal at every step): the same run, step for step
+    from twin.recording import Recording
+
+    for r in result.records:
+        rec = Recording.open(tmp_path / "failures" / f"{r['index']:04d}.csv")
+        assert len(rec) == r["measured"]["steps"] + 1  # the state before the first step, then each step
+        assert rec.time[-1] == pytest.approx(r["measured"]["time"])
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            pass
+        else:  # and its plot
+            assert (tmp_path / "failures" / f"{r['index']:04d}.png").stat().st_size > 10_000
+        if r["measured"]["part_present"]:
+            assert rec.column("ring.x")[-1] * 1000.0 == r["measured"]["part_end_mm"][0]  # the very run, bit for bit
+        else:
+            assert not rec.column("ring.present")[-1]
 
 
 def test_a_crash_and_a_hang_fail_alone_with_a_clear_reason(tmp_path):

@@ -69,12 +69,12 @@ def hung(timeout: float) -> dict:
 class _ForkJob:
     """One scenario in a process forked from the fork server."""
 
-    def __init__(self, ctx, campaign, index: int, log: str):
+    def __init__(self, ctx, campaign, index: int, log: str, record_to: str | None = None):
         from .worker import child_main
 
         self.log = log
         self.reader, writer = ctx.Pipe(duplex=False)
-        self.proc = ctx.Process(target=child_main, args=(campaign, index, writer, log), daemon=True)
+        self.proc = ctx.Process(target=child_main, args=(campaign, index, writer, log, record_to), daemon=True)
         with _without_main_module():
             self.proc.start()
         writer.close()
@@ -113,10 +113,10 @@ class _ForkJob:
 class _SpawnJob:
     """One scenario in a fresh interpreter (where this process may not fork children)."""
 
-    def __init__(self, campaign, index: int, log: str):
+    def __init__(self, campaign, index: int, log: str, record_to: str | None = None):
         fd, self.src = tempfile.mkstemp(prefix="campaign-in-", suffix=".pkl")
         with os.fdopen(fd, "wb") as f:
-            pickle.dump((campaign, index), f)
+            pickle.dump((campaign, index, record_to), f)
         self.dst = self.src + ".out"
         self.log = log
         with open(log, "wb") as out:
@@ -191,9 +191,11 @@ class LocalBackend:
             raise ValueError(f"at least one worker, not {workers}")
         self.workers, self.timeout = int(workers), timeout
 
-    def run(self, campaign, indices: Iterable[int], on_result: OnResult) -> None:
+    def run(self, campaign, indices: Iterable[int], on_result: OnResult, record: dict | None = None) -> None:
+        """`record`: index -> a file to record that scenario's run into (twin.recording)."""
         timeout = self.timeout if self.timeout is not None else campaign.timeout
         pending = list(indices)
+        record = record or {}
         forking = _may_fork() and "forkserver" in multiprocessing.get_all_start_methods()
         ctx = _fork_context() if forking else None
         running: dict[int, tuple[object, float, float]] = {}
@@ -203,7 +205,8 @@ class LocalBackend:
                 while pending and len(running) < self.workers:
                     index = pending.pop(0)
                     log = os.path.join(logdir.name, f"{index}.log")
-                    job = _ForkJob(ctx, campaign, index, log) if forking else _SpawnJob(campaign, index, log)
+                    rec = record.get(index)
+                    job = _ForkJob(ctx, campaign, index, log, rec) if forking else _SpawnJob(campaign, index, log, rec)
                     t0 = time.monotonic()
                     running[index] = (job, t0, t0 + timeout)
                 now = time.monotonic()

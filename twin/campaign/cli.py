@@ -55,6 +55,8 @@ def add_command(subparsers) -> None:
     p.add_argument("--resume", action="store_true", help="skip the scenarios already in the output folder's results file")
     p.add_argument("--timeout", type=_seconds, help="wall seconds one scenario may take (default: run.timeout of the file)")
     p.add_argument("--only", type=_indices, metavar="N,M-K", help="run only these scenarios (by number)")
+    p.add_argument("--recordings", type=int, default=10, metavar="N",
+                   help="record and plot at most N failing scenarios (re-run, in failures/; default 10, 0: none)")
     p.add_argument("--list", action="store_true", help="list the scenarios and their expectations, run nothing")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_campaign)
@@ -93,7 +95,8 @@ def cmd_campaign(args) -> int:
     if Path(args.spec).stem == "campaign":
         out = Path(args.out) if args.out else Path("campaign-results") / Path(args.spec).resolve().parent.name
     try:
-        result = run_campaign(campaign, backend, out, resume=args.resume, indices=args.only, quiet=args.quiet)
+        result = run_campaign(campaign, backend, out, resume=args.resume, indices=args.only, quiet=args.quiet,
+                              max_recordings=max(0, args.recordings))
     except RuntimeError as exc:
         print(f"twin campaign: error: {exc}", file=sys.stderr)
         return 2

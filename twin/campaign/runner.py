@@ -7,12 +7,11 @@
 The results file (`results.jsonl`) gets one line per finished scenario as soon as it ends, so an
 interrupted campaign loses nothing; with `resume=True` the scenarios already in it (same parameters and
 expectations) are not run again. At the end: `results.csv` (the table, in scenario order, identical for
-identical scenarios whatever the backend and worker count), `junit.xml`, `summary.txt`, and for each
-failing scenario that traced signals (`campaign.record`) its trace in `failures/`.
+identical scenarios whatever the backend and worker count), `junit.xml`, `summary.txt`, and for the first
+`max_recordings` failing scenarios a recording and a plot in `failures/` (re-run on this machine).
 """
 from __future__ import annotations
 
-import csv
 import json
 import time
 from dataclasses import dataclass, field
@@ -54,7 +53,8 @@ def _load_previous(path: Path, campaign: Campaign) -> dict[int, dict]:
 
 
 def run_campaign(campaign: Campaign, backend, out_dir: str | Path, *, resume: bool = False,
-                 indices: list[int] | None = None, progress_stream=None, quiet: bool = False) -> CampaignResult:
+                 indices: list[int] | None = None, progress_stream=None, quiet: bool = False,
+                 max_recordings: int = 10) -> CampaignResult:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     results_path = out / RESULTS
@@ -73,8 +73,6 @@ def run_campaign(campaign: Campaign, backend, out_dir: str | Path, *, resume: bo
         sc = campaign.scenarios[index]
         measured = envelope["measured"]
         status, failures = judge(campaign, sc, measured)
-        if status == "pass":
-            measured.pop("trace", None)  # traces are kept for the failing scenarios' plots only
         rec = {"index": index, "key": sc.key, "name": sc.name, "params": sc.params, "measured": measured,
                "status": status, "failures": failures, "wall": envelope.get("wall", 0.0),
                "wall_run": envelope.get("wall_run"), "wall_load": envelope.get("wall_load"),
@@ -97,43 +95,44 @@ def run_campaign(campaign: Campaign, backend, out_dir: str | Path, *, resume: bo
     report.write_junit(out / "junit.xml", campaign.name, recs)
     text = report.summary_text(campaign.name, recs, len(wanted), wall, getattr(backend, "name", "?"))
     (out / "summary.txt").write_text(text)
-    _write_failure_traces(out, recs)
+    if max_recordings:
+        _record_failures(campaign, out, recs, max_recordings)
     counts = {s: sum(r["status"] == s for r in recs) for s in ("pass", "fail", "error")}
     return CampaignResult(recs, len(wanted), wall, out, counts)
 
 
-def _write_failure_traces(out: Path, records: list[dict]) -> None:
-    """Each failing scenario's traced signals as CSV, and a plot of them when matplotlib is installed."""
+def _record_failures(campaign: Campaign, out: Path, records: list[dict], limit: int) -> list[int]:
+    """Run each failing scenario once more, recorded (twin.recording: every signal and body pose at every
+    step, as CSV), and plot it when matplotlib is installed (twin.plot): `failures/NNNN.csv`, `.png`. The
+    runs are deterministic, so the re-run is the failing run. Crashed and hung scenarios are not re-run."""
+    from .backends import LocalBackend
+
+    wanted = [r["index"] for r in records if r["status"] == "fail"
+              or (r["status"] == "error" and r["measured"].get("outcome") == "error")][:limit]
+    if not wanted:
+        return []
     folder = out / "failures"
-    for r in records:
-        trace = r["measured"].get("trace")
-        if r["status"] == "pass" or not trace:
-            continue
-        folder.mkdir(exist_ok=True)
-        stem = folder / f"{r['index']:04d}"
-        with stem.with_suffix(".csv").open("w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(trace["signals"])
-            w.writerows(trace["rows"])
-        _plot(stem.with_suffix(".png"), r, trace)
+    folder.mkdir(exist_ok=True)
+    paths = {i: str(folder / f"{i:04d}.csv") for i in wanted}
+    done: list[int] = []
+    LocalBackend(1, timeout=campaign.timeout).run(campaign, wanted, lambda i, env: done.append(i), record=paths)
+    by_index = {r["index"]: r for r in records}
+    for i in done:
+        _plot(Path(paths[i]), by_index[i], campaign)
+    return sorted(done)
 
 
-def _plot(path: Path, record: dict, trace: dict) -> None:
+def _plot(path: Path, record: dict, campaign: Campaign) -> None:
     try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        import matplotlib  # noqa: F401
     except ImportError:
         return
-    names = trace["signals"][1:]
-    rows = trace["rows"]
-    fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(9, 1.6 * len(names) + 1), squeeze=False)
-    times = [row[0] for row in rows]
-    for k, (name, ax) in enumerate(zip(names, axes[:, 0]), start=1):
-        ax.plot(times, [float(row[k]) if not isinstance(row[k], str) else 0.0 for row in rows], lw=1)
-        ax.set_ylabel(name, rotation=0, ha="right", fontsize=8)
-    axes[-1, 0].set_xlabel("simulated time (s)")
-    fig.suptitle(f"[{record['index']}] {record['name']}\n" + "; ".join(record["failures"])[:200], fontsize=8)
-    fig.savefig(path, dpi=80)
-    plt.close(fig)
+    from twin.plot import plot_recording
+    from twin.recording import Recording
+
+    if not path.exists():
+        return
+    rec = Recording.open(path)
+    signals = [n for n in campaign.record if n in {s["name"] for s in rec.scene.signals}] or None
+    title = f"[{record['index']}] {record['name']}: " + ("; ".join(record["failures"]) or "")
+    plot_recording(rec, signals, path.with_suffix(".png"), title=title[:160])

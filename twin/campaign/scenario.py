@@ -153,17 +153,15 @@ def _unit(twin, signal: str, fault: str) -> str:
 
 # -- what is watched while it runs ---------------------------------------------------------------------------
 class Monitor:
-    """A device stepped with the twin: the true finger forces (not the readings), grips, slip, a trace."""
+    """A device stepped with the twin: the true finger forces (not the readings), grips, slip."""
 
     signals: tuple = ()
 
-    def __init__(self, twin, record: tuple[str, ...] = ()):
+    def __init__(self, twin):
         self.max_force = 0.0
         self.gripped_edges = 0
         self.slip = False if "slip" in {s.name for s in twin.signals} else None
         self._was_gripped = bool(twin.read("doGripped"))
-        self.record = tuple(n for n in record if n in {s.name for s in twin.signals})
-        self.trace: list[list] = []
 
     def read(self, name):
         raise KeyError(name)
@@ -184,12 +182,6 @@ class Monitor:
         self._was_gripped = gripped
         if self.slip is not None and twin.read("slip"):
             self.slip = True
-        if self.record:
-            self.trace.append([round(twin.time, 9), *(_plain(twin.read(n)) for n in self.record)])
-
-
-def _plain(v):
-    return v if isinstance(v, (bool, int, float, str)) else str(v)
 
 
 class Signals:
@@ -333,11 +325,12 @@ class Context:
         self.measured[name] = value
 
 
-def run_scenario(campaign: Campaign, index: int) -> dict:
-    """Run scenario `index` of `campaign`; the measured values (see docs/campaigns.md, "The results")."""
+def run_scenario(campaign: Campaign, index: int, record_to: str | None = None) -> dict:
+    """Run scenario `index` of `campaign`; the measured values (see docs/campaigns.md, "The results").
+    `record_to`: also record the run (every signal and body pose at every step) into this file."""
     scenario = campaign.scenarios[index]
     try:
-        return _run(campaign, scenario)
+        return _run(campaign, scenario, record_to)
     except ScenarioError as exc:
         return {"outcome": "error", "fault": "scenario_error", "message": str(exc)}
     except Exception as exc:  # noqa: BLE001 - one scenario's failure is its result, named
@@ -347,7 +340,8 @@ def run_scenario(campaign: Campaign, index: int) -> dict:
         return {"outcome": "error", "fault": kind, "message": f"{type(exc).__name__}: {exc}"}
 
 
-def _run(campaign: Campaign, scenario: Scenario) -> dict:
+def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -> dict:
+    import contextlib
     import time
 
     from twin.core import Twin
@@ -369,6 +363,7 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
         station = dataclasses.replace(station, controller=dataclasses.replace(station.controller, program=program))
     with quiet_native_output():
         twin = Twin(station)
+    stack = contextlib.ExitStack()
     try:
         from twin.cell import add_watchdog
 
@@ -387,8 +382,12 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
             injector = FaultInjector.attach(twin, plant)
         except FaultError as exc:
             raise ScenarioError(str(exc)) from None
-        monitor = Monitor(twin, campaign.record)
+        monitor = Monitor(twin)
         twin.add_device(monitor)
+        if record_to is not None:  # a recording of every signal and pose at every step (twin.recording)
+            from twin.recording import record
+
+            stack.enter_context(record(twin, record_to))
         part = campaign.measure.get("part") or (station.targets[0].name if station.targets else None)
         part_start = twin.object_pose(part)[0] if part else None
         logic, local = None, {}
@@ -493,10 +492,9 @@ def _run(campaign: Campaign, scenario: Scenario) -> dict:
             result["comm_lost_trips"] = watchdog.trips
         for k, v in ctx.measured.items():
             result[f"m.{k}" if k in result else k] = v
-        if monitor.record:
-            result["trace"] = {"signals": ["time", *monitor.record], "rows": monitor.trace}
         return result
     finally:
+        stack.close()
         twin.close()
 
 

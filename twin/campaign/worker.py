@@ -27,10 +27,10 @@ import twin.faults  # noqa: E402,F401
 from .scenario import LAST_TIMING, run_scenario  # noqa: E402
 
 
-def execute(campaign, index: int) -> dict:
+def execute(campaign, index: int, record_to: str | None = None) -> dict:
     """Run one scenario; the envelope: measured values and wall times (s) of the whole and of the run."""
     t0 = time.perf_counter()
-    measured = run_scenario(campaign, index)
+    measured = run_scenario(campaign, index, record_to)
     return {"measured": measured, "wall_run": time.perf_counter() - t0, "wall_load": LAST_TIMING.get("load"),
             "wall_sim": LAST_TIMING.get("sim")}
 
@@ -43,20 +43,21 @@ def redirect_output(log_path: str) -> None:
     os.close(fd)
 
 
-def child_main(campaign, index: int, conn, log_path: str) -> None:
+def child_main(campaign, index: int, conn, log_path: str, record_to: str | None = None) -> None:
     """Entry point of a forked scenario process: run, send the envelope, exit."""
     redirect_output(log_path)
-    envelope = execute(campaign, index)
+    envelope = execute(campaign, index, record_to)
     conn.send(envelope)
     conn.close()
 
 
 def main(argv: list[str]) -> int:
-    """`python -m twin.campaign.worker IN OUT`: IN holds (campaign, index) pickled, OUT gets the envelope."""
+    """`python -m twin.campaign.worker IN OUT`: IN holds (campaign, index, record_to) pickled, OUT gets the
+    envelope."""
     src, dst = argv
     with open(src, "rb") as f:
-        campaign, index = pickle.load(f)
-    envelope = execute(campaign, index)
+        campaign, index, record_to = pickle.load(f)
+    envelope = execute(campaign, index, record_to)
     tmp = dst + ".part"
     with open(tmp, "wb") as f:
         pickle.dump(envelope, f)
