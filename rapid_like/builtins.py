@@ -162,6 +162,9 @@ _ENUMS: dict[str, dict[str, tuple[str, float]]] = {
     "errdomain": {n: ("errdomain", i) for i, n in enumerate(
         ("COMMON_ERR", "OP_STATE", "SYSTEM_ERR", "HARDWARE_ERR", "PROGRAM_ERR", "MOTION_ERR", "OPERATOR_ERR",
          "IO_COM_ERR", "USER_DEF_ERR", "SYNCHRO_ERR", "PROCESS_ERR", "CFG_ERR"))},
+    "aiotrigg": {n: ("num", i) for i, n in enumerate(
+        ("AIO_ABOVE_HIGH", "AIO_BELOW_HIGH", "AIO_ABOVE_LOW", "AIO_BELOW_LOW", "AIO_BETWEEN", "AIO_OUTSIDE",
+         "AIO_ALWAYS"), 1)},
     "errtype": {"TYPE_ALL": ("errtype", 0), "TYPE_STATE": ("errtype", 1), "TYPE_WARN": ("errtype", 2),
                 "TYPE_ERR": ("errtype", 3)},
 }
@@ -317,6 +320,14 @@ _INSTRUCTIONS = {
     "SearchL": r"\switch Stop | switch PStop | switch SStop | switch Sup, signaldi Signal, \switch Flanks, "
                r"INOUT robtarget SearchPoint, robtarget ToPoint, \num ID, speeddata Speed, \num V | num T, "
                r"tooldata Tool, \wobjdata WObj, \loaddata TLoad",
+    "MoveJSync": r"robtarget ToPoint, \num ID, speeddata Speed, \num T, zonedata Zone, tooldata Tool, "
+                 r"\wobjdata WObj, string ProcName, \loaddata TLoad",
+    "MoveLSync": r"robtarget ToPoint, \num ID, speeddata Speed, \num T, zonedata Zone, tooldata Tool, "
+                 r"\wobjdata WObj, string ProcName, \loaddata TLoad",
+    "ISignalAI": r"\switch Single | switch SingleSafe, signalai Signal, num Condition, num HighValue, num LowValue, "
+                 r"num DeltaValue, \switch DPos | switch DNeg, intnum Interrupt",
+    "ISignalAO": r"\switch Single | switch SingleSafe, signalao Signal, num Condition, num HighValue, num LowValue, "
+                 r"num DeltaValue, \switch DPos | switch DNeg, intnum Interrupt",
     "SpyStart": "string File",
     "SpyStop": "",
     "BookErrNo": "INOUT errnum ErrorName",

@@ -556,7 +556,14 @@ class Checker:
         word = B.PROPER_NAMES.get(key, s.name)
         if key in _APPROXIMATE:
             self.warn(s.span, f"{word}: {_APPROXIMATE[key]}")
-        if key in ("movej", "movel", "movec", "moveabsj", "movejdo", "moveldo"):
+        if key in ("movejsync", "movelsync"):
+            proc = next((a.value for a in s.args if a.key == "procname" or (not a.optional and isinstance(
+                a.value, n.StrLit) and a is s.args[-1])), None)
+            if isinstance(proc, n.StrLit) and not isinstance(self.routines.get(proc.value.lower()), n.Routine):
+                raise self.err(f"{s.name}: no PROC named {proc.value!r} to call at the point", proc.span)
+            self.warn(s.span, f"{word}: the procedure runs when the robot is at the point (not in the middle "
+                              f"of the corner path)")
+        if key in ("movej", "movel", "movec", "moveabsj", "movejdo", "moveldo", "movejsync", "movelsync"):
             zone = next((a for a in s.args if a.value is not None and not a.optional and a.value.text.lower() in
                          B.zone_names()), None)
             if any(a.optional and a.key == "conc" for a in s.args):

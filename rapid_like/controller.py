@@ -176,7 +176,7 @@ class Controller:
     def _ready(self, w: Wait) -> bool:
         if self.interp.interrupts.pending and w.kind != "stop":
             return True  # a TRAP runs while the program waits
-        if w.kind in ("time", "poll", "io"):
+        if w.kind in ("time", "poll", "io", "pace"):
             return self.now >= (w.at or 0)
         if w.kind == "step":
             return True  # a loop that used up its budget goes on at the next tick, whenever it comes
@@ -197,8 +197,9 @@ class Controller:
                     self.interp.suspensions += 1
                     return
                 # a new tick: a new loop budget, a small one for a loop that used up the last tick's
-                polling = self.wait is not None and self.wait.kind == "step"
+                polling = self.wait is not None and self.wait.kind in ("step", "pace")
                 self.interp.spins = 0
+                self.interp.polling = polling
                 self.interp.tick_budget = min(self.interp.loop_budget, POLL_BUDGET) if polling else \
                     self.interp.loop_budget
                 while True:
@@ -210,7 +211,7 @@ class Controller:
                     if w.kind == "stop":
                         self.state, self.end_reason = STOPPED, "stop"
                         return
-                    if w.kind in ("time", "poll", "io") and self._ready(w):
+                    if w.kind in ("time", "poll", "io", "pace") and self._ready(w):
                         continue
                     self.state = WAITING
                     self.interp.suspensions += 1

@@ -16,7 +16,7 @@ from . import builtins as B
 from . import nodes as n
 from .host import MotionRequest
 from .runtime import ABSENT, PULSE, SDELAY, Frame, Wait, to_ns
-from .values import SIGNAL_TYPES, Record, fmt_num, format_value, json_num
+from .values import SIGNAL_TYPES, Record, fmt_num, format_value, json_num, xyz
 
 
 class InstructionsMixin:
@@ -318,6 +318,22 @@ class InstructionsMixin:
             yield from self.pause(Wait("motion", None, "WaitRob", s.span))
         self.concurrent = None
 
+    def _move_sync(self, s, arg, text, bound, instr: str):
+        """MoveJSync/MoveLSync: the motion, then the PROC named by ProcName (called at the end point)."""
+        yield from self._move(s, arg, text, bound, instr)
+        name = arg("procname")
+        r = self.routine_for(name.lower(), arg.frame)
+        if r is None or r.kind != "PROC" or any(not p.optional for p in r.params):
+            raise self.fail(f"{s.name}: no PROC without parameters named {name!r}", bound["procname"].value.span,
+                            "ERR_REFUNKPRC")
+        yield from self.invoke(r, Frame(r))
+
+    def i_movejsync(self, s, arg, text, bound):
+        yield from self._move_sync(s, arg, text, bound, "MoveJ")
+
+    def i_movelsync(self, s, arg, text, bound):
+        yield from self._move_sync(s, arg, text, bound, "MoveL")
+
     def i_movejdo(self, s, arg, text, bound):
         yield from self._move(s, arg, text, bound, "MoveJ")
         self.write(arg("signal"), 0.0 if arg("value") == 0 else 1.0)
@@ -421,10 +437,29 @@ class InstructionsMixin:
         radius = float(zone["pzone_tcp"]) if not zone["finep"] else 0.0
         if arg("z") is not None:  # \Z: the zone size in mm, instead of the zonedata's
             radius = float(arg("z"))
-        while not self.host.motion_done(handle):
+        previous, self.last_position = self.last_position, (
+            xyz(target.fields["trans"]) if target.type == "robtarget" else None)
+        if self.host.motion_done(handle):
+            # A motion that is over at once (offline) took no time: it counts as a turn of a time-less
+            # loop. In a polling loop (one that used up a whole tick, see interpreter.py) it takes the
+            # time the robot would need, distance / v_tcp (at least 1 ms), so a loop of motions that
+            # never waits runs at a robot's pace, at a bounded cost per simulated second.
+            if self.polling:
+                seconds = 0.0
+                if previous is not None and self.last_position is not None and speed.fields["v_tcp"] > 0:
+                    seconds = math.dist(previous, self.last_position) / float(speed.fields["v_tcp"])
+                until = self.now + max(to_ns(seconds), to_ns(0.001))
+                while self.now < until:
+                    yield from self.pause(Wait("pace", until, f"{instr} {req.target_name}", s.span))
+            else:
+                yield from self.spin(f"{instr} {req.target_name}", s.span)
+            return
+        while True:
             if radius > 0 and in_zone is not None and in_zone(handle, radius):
                 break  # a zone: the program goes on as the robot enters it
             yield from self.pause(Wait("motion", None, f"{instr} {req.target_name}", s.span))
+            if self.host.motion_done(handle):
+                break
 
     def i_movej(self, s, arg, text, bound):
         yield from self._move(s, arg, text, bound, "MoveJ")

@@ -67,6 +67,7 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         self.stop_move = False
         self.files: dict[str, str] = {}  # files the program wrote (Open ... \\Write; Write), by path
         self.concurrent = None  # the handle of a \\Conc motion still running
+        self.last_position: tuple | None = None  # the last Cartesian target (mm), for offline motion times
         self.predefined = {k: Cell(t, v, "CONST", k) for k, (t, v) in B.predefined_data().items()}
         self.active_tool = self.predefined["tool0"].value
         self.active_wobj = self.predefined["wobj0"].value
@@ -77,6 +78,7 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         self.loop_budget = max(1, int(loop_budget))  # time-less loop iterations per tick
         self.spins = 0  # time-less loop iterations in this tick (reset by the controller every tick)
         self.tick_budget = self.loop_budget  # this tick's: POLL_BUDGET for a loop that used up a whole tick
+        self.polling = False  # this tick goes on with a loop that used up a whole tick (a polling loop)
         # Bumped by everything that changes the program's state or the world (assignments, loop
         # variables, INOUT arguments, ERRNO, events) or depends on the time (ClkRead): a tick that
         # leaves it unchanged and ends at the same loop would do the same again at the next tick.

@@ -12,7 +12,7 @@ error in a TRAP stops the program (a TRAP has no caller to raise it to).
 Edges, as the manual defines them: ISignalDI/DO with 1 occurs when the signal goes from 0 to 1,
 with 0 when it goes from 1 to 0, with `edge` (2) at either; a signal that already has the value
 when the order is given does not trigger it. ISignalGI/GO occur at every change of the group's
-value. ITimer occurs `Time` seconds after the order, then every `Time` seconds (once with \\Single).
+value. ISignalAI/AO occur when their condition becomes true. ITimer occurs `Time` seconds after the order, then every `Time` seconds (once with \\Single).
 IPers occurs when the persistent's value changes. IError orders are accepted and never occur.
 """
 from __future__ import annotations
@@ -71,6 +71,11 @@ class InterruptTable:
     def signal_order(self, no: int, signal: str, trigger: float | None, single: bool) -> None:
         self.order(no, Order("signal", single, signal, trigger, self.interp.host.read_signal(signal)))  # type: ignore
 
+    def analog_order(self, no: int, signal: str, test, single: bool) -> None:
+        o = Order("analog", single, signal, last=False)
+        o.ref = test  # type: ignore[assignment]
+        self.order(no, o)
+
     def timer_order(self, no: int, seconds: float, single: bool) -> None:
         period = max(1, to_ns(seconds))
         self.order(no, Order("timer", single, period=period, due=self.interp.now + period))  # type: ignore
@@ -100,6 +105,9 @@ class InterruptTable:
                 if value != o.last:
                     fired = o.trigger is None or o.trigger == 2 or value == o.trigger
                     o.last = value
+            elif o.kind == "analog":
+                now_true = bool(o.ref(self.interp.host.read_signal(o.signal)))  # type: ignore[misc, attr-defined]
+                fired, o.last = now_true and not o.last, now_true
             elif o.kind == "timer":
                 while o.due <= now:
                     fired = True

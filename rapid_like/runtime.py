@@ -31,6 +31,8 @@ class Wait:
     """What a suspended program waits for.
 
     kind "time" / "poll": resume at the first tick with now >= at.
+    kind "pace": an offline motion in a polling loop takes its time (like "time", and the loop stays a
+    polling loop).
     kind "step": a loop used up the tick's loop budget; ready at the next tick, whenever it comes
     (`at`, set for event-driven runners, is when that tick is due at the latest).
     kind "signal" / "motion": re-evaluate on every tick; `at` (a timeout) is only a hint for

@@ -216,6 +216,21 @@ class SystemMixin:
 
     i_isignalgo = i_isignalgi
 
+    def i_isignalai(self, s, arg, text, bound):
+        """ISignalAI/AO: the interrupt occurs when the condition (AIO_ABOVE_HIGH ... AIO_ALWAYS) becomes
+        true; DeltaValue, \\DPos and \\DNeg are accepted and not used."""
+        no = self._intno(arg, bound)
+        cond, high, low = int(arg("condition")), arg("highvalue"), arg("lowvalue")
+        tests = {1: lambda v: v > high, 2: lambda v: v < high, 3: lambda v: v > low, 4: lambda v: v < low,
+                 5: lambda v: low <= v <= high, 6: lambda v: v < low or v > high, 7: lambda v: True}
+        if cond not in tests:
+            raise self.fail(f"{s.name}: Condition must be AIO_ABOVE_HIGH ... AIO_ALWAYS (1 to 7), not {cond}",
+                            bound["condition"].value.span, "ERR_ARGVALERR")
+        self.interrupts.analog_order(no, arg("signal").name, tests[cond], bool(arg("single") or arg("singlesafe")))
+        yield from ()
+
+    i_isignalao = i_isignalai
+
     def i_itimer(self, s, arg, text, bound):
         no = self._intno(arg, bound)
         t = arg("time")

@@ -200,3 +200,19 @@ def test_check_lists_what_is_approximate_with_file_and_line(tmp_path: Path):
     assert lines[0].startswith(f"{p}:3:5: warning: VelSet: ")
     assert lines[1].startswith(f"{p}:4:26: warning: MoveL with zone z10: ")
     assert lines[2].startswith(f"{p}:5:5: warning: MoveL \\Conc: ")
+
+
+def test_a_loop_of_motions_that_never_waits_runs_at_the_robots_pace_offline(tmp_path: Path):
+    p = tmp_path / "paced.mod"
+    p.write_text("MODULE PacedLoop\n"
+                 "  CONST robtarget pA := [[0,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                 "  CONST robtarget pB := [[100,0,0],[1,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];\n"
+                 "  PROC main()\n    WHILE TRUE DO\n      MoveL pA, v50, fine, tool0;\n      MoveL pB, v50, fine, tool0;\n"
+                 "    ENDWHILE\n  ENDPROC\nENDMODULE\n")
+    code, out, err = run_cli(["run", str(p), "--max-time", "20", "--loop-budget", "30", "--trace"])
+    assert (code, err) == (0, "")
+    times = [json.loads(x)["t"] for x in out.splitlines() if '"move"' in x]
+    later = [t for t in times if t > 0]
+    # the first tick's turns take no time; from then on each 100 mm at 50 mm/s takes 2 s
+    assert len(later) >= 9 and all(b - a == pytest.approx(2.0) for a, b in zip(later[1:], later[2:]))
+    assert len(times) - len(later) <= 30  # the first tick's budget (30 turns here) bounds the instant ones
