@@ -18,7 +18,7 @@ NONE_URI = "http://opcfoundation.org/UA/SecurityPolicy#None"
 
 
 def run(coro):
-    return asyncio.run(asyncio.wait_for(coro, 120))
+    return asyncio.run(asyncio.wait_for(coro, 600))
 
 
 async def client_certificate(folder):

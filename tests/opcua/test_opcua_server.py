@@ -32,7 +32,7 @@ def lockstep():
 
 
 def run(coro):
-    return asyncio.run(asyncio.wait_for(coro, 120))
+    return asyncio.run(asyncio.wait_for(coro, 600))
 
 
 # -- Modbus, as the reference front end ------------------------------------------------------------------
@@ -69,7 +69,7 @@ def urdf_limits(path, joint):
 
 def test_browse_folders_and_every_signal_is_one_variable_named_by_its_signal(lockstep, rmap):
     async def main():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             assert ns >= 2
             children = {(await ch.read_browse_name()).Name: ch for ch in await c.nodes.objects.get_children()}
@@ -108,7 +108,7 @@ def test_browse_folders_and_every_signal_is_one_variable_named_by_its_signal(loc
 
 def test_engineering_units_and_ranges_follow_the_urdf_and_unece(lockstep):
     async def main():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             out = {}
             for name in ("L2", "L5", "L2.force", "robot.j1"):
@@ -140,7 +140,7 @@ def test_every_signal_reads_as_over_modbus_at_the_same_lockstep_step(lockstep, r
         over_modbus = {e.name: modbus_read(mb, e) for e in rmap}
 
         async def main():
-            async with Client(lockstep.url, timeout=60) as c:
+            async with Client(lockstep.url, timeout=240) as c:
                 ns = await namespace(c)
                 names = [e.name for e in rmap]
                 values = await c.read_values([node(c, ns, n) for n in names])
@@ -170,7 +170,7 @@ def test_every_signal_reads_as_over_modbus_at_the_same_lockstep_step(lockstep, r
 
 def test_written_setpoints_are_applied_and_grip_the_ring(lockstep, rmap):
     async def main():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             for name in ("L2", "L3", "L4"):
                 assert await write_status(node(c, ns, name), 0.30, ua.VariantType.Double) == "Good"
@@ -189,7 +189,7 @@ def test_written_setpoints_are_applied_and_grip_the_ring(lockstep, rmap):
     assert values["L2.force"] > 1.0
     # open again for the other tests
     async def reopen():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             for name in ("L2", "L3", "L4"):
                 assert await write_status(node(c, ns, name), 0.35, ua.VariantType.Double) == "Good"
@@ -200,7 +200,7 @@ def test_written_setpoints_are_applied_and_grip_the_ring(lockstep, rmap):
 
 def test_out_of_range_and_wrong_typed_writes_are_refused_and_change_nothing(lockstep, rmap):
     async def main():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             L2, active, gripped, present = (node(c, ns, n) for n in ("L2", "Active", "doGripped", "ring.present"))
             before = await L2.read_value()
@@ -238,7 +238,7 @@ def grip_run(via_opcua: bool, rmap) -> list[tuple]:
     seen = []
     with OpcUaServerProcess(RING_RIG, "--lockstep") as server, modbus(server) as mb:
         async def main():
-            async with Client(server.url, timeout=60) as c:
+            async with Client(server.url, timeout=240) as c:
                 ns = await namespace(c)
                 outputs = [e for e in rmap if e.access == "r" and e.name != "sim.map_crc"]
                 nodes = [node(c, ns, e.name) for e in outputs]
@@ -286,7 +286,7 @@ def test_a_subscription_sees_every_step_even_when_it_publishes_slower(lockstep):
     """sim.step changes every step: each value lasts one step. A 100 ms publishing interval with a requested
     queue of 1 still gets every one of them (the queue is revised up)."""
     async def main():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             col = Collector()
             sub = await c.create_subscription(ua.CreateSubscriptionParameters(
@@ -310,7 +310,7 @@ def test_a_subscription_sees_every_step_even_when_it_publishes_slower(lockstep):
 
 def test_intervals_below_the_step_are_revised_to_the_step(lockstep):
     async def main():
-        async with Client(lockstep.url, timeout=60) as c:
+        async with Client(lockstep.url, timeout=240) as c:
             ns = await namespace(c)
             result = await c.uaclient.create_subscription(ua.CreateSubscriptionParameters(
                 RequestedPublishingInterval=1, RequestedLifetimeCount=1000, RequestedMaxKeepAliveCount=10,
@@ -333,7 +333,7 @@ def test_intervals_below_the_step_are_revised_to_the_step(lockstep):
 def test_a_subscription_sees_doGripped_rise_during_a_grip_in_real_time():
     with OpcUaServerProcess(RING_RIG) as server:
         async def main():
-            async with Client(server.url, timeout=60) as c:
+            async with Client(server.url, timeout=240) as c:
                 ns = await namespace(c)
                 col = Collector()
                 sub = await c.create_subscription(12, col)
@@ -363,7 +363,7 @@ def test_sim_advance_is_refused_in_real_time():
         assert server.port is None and not any("listening on 127" in line for line in server.lines)
 
         async def main():
-            async with Client(server.url, timeout=60) as c:
+            async with Client(server.url, timeout=240) as c:
                 ns = await namespace(c)
                 with pytest.raises(ua.uaerrors.BadInvalidState):
                     await advance(c, ns, 10)

@@ -6,7 +6,7 @@ const { OPCUAClient, MessageSecurityMode, SecurityPolicy, AttributeIds, DataType
 
 async function main() {
   const [endpoint, station] = process.argv.slice(2);
-  const client = OPCUAClient.create({ endpointMustExist: false, securityMode: MessageSecurityMode.None,
+  const client = OPCUAClient.create({ endpointMustExist: false, defaultTransactionTimeout: 300000, securityMode: MessageSecurityMode.None,
                                       securityPolicy: SecurityPolicy.None, connectionStrategy: { maxRetry: 2 },
                                       requestedSessionTimeout: 60000 });
   const out = {};
