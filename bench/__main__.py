@@ -14,6 +14,7 @@ BENCHMARKS = {
     "campaign": "bench.campaign",  # scenarios/min and parallel efficiency, local pool vs Dask on loopback
     "rapid": "bench.rapid_polling",  # RAPID polling loops offline: wall time per simulated second
     "opcua": "bench.opcua",  # OPC UA vs Modbus on the same cell: latency, change delay, 1000 monitored items
+    "view": "bench.view",  # the live page and recording: late steps, page updates per s, recording cost per step
 }
 
 

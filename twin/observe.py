@@ -146,6 +146,12 @@ class Observer:
             robot_targets={n: [*p.xyz, *c.getQuaternionFromEuler(p.rpy)] for n, p in st.robot_targets.items()},
             signals=[_signal_dict(s) for s in twin.signals])
         self._names = [s.name for s in twin.signals]
+        self._base_pose_t = tuple(float(v) for v in self._base_pose)
+        self._other_ids = [uid for _, uid in self._others]
+        self._cid = c._client  # the connection's id (BulletClient keeps it here)
+        import pybullet
+
+        self._pb = pybullet
 
     @staticmethod
     def _visual(body: str, v) -> Visual:
@@ -187,25 +193,35 @@ class Observer:
             fingers.append(FingerView(f.name, tuple(f.links), tuple(chain)))
         return fingers
 
-    def frame(self) -> Frame:
-        twin, c = self.twin, self._c
+    def raw(self) -> tuple:
+        """The state now as plain tuples: (step, time, values, poses flat (x y z qx qy qz qw per body), joints).
+
+        The cheap form a recorder keeps for every step; `frame()` makes a `Frame` of it."""
+        twin, cid, pybullet = self.twin, self._cid, self._pb
         read = twin.read
-        values = tuple(read(n) for n in self._names)
-        poses = np.empty((len(self.scene.bodies), 7))
-        poses[0] = self._base_pose
+        values = tuple([read(n) for n in self._names])
+        poses = list(self._base_pose_t)
+        # pybullet's functions called directly with the connection's id: BulletClient's per-call wrapper
+        # costs more than the calls themselves
         if self._link_indices:
-            states = c.getLinkStates(self._machine, self._link_indices, computeForwardKinematics=1)
-            for k, s in enumerate(states, start=1):
-                poses[k, :3] = s[4]
-                poses[k, 3:] = s[5]
-        k0 = 1 + len(self._link_indices)
-        for k, (_, uid) in enumerate(self._others, start=k0):
-            pos, orn = c.getBasePositionAndOrientation(uid)
-            poses[k, :3] = pos
-            poses[k, 3:] = orn
-        joints = np.array([s[0] for s in c.getJointStates(self._machine, self._joint_indices)]) if self._joint_indices \
-            else np.empty(0)
-        return Frame(twin.step_count, twin.time, values, poses, joints)
+            # after a step pybullet's link frames are current; before the first one, compute them
+            states = pybullet.getLinkStates(self._machine, self._link_indices,
+                                            computeForwardKinematics=not twin.step_count, physicsClientId=cid)
+            for s in states:
+                poses += s[4]
+                poses += s[5]
+        for uid in self._other_ids:
+            pos, orn = pybullet.getBasePositionAndOrientation(uid, physicsClientId=cid)
+            poses += pos
+            poses += orn
+        joints = tuple([s[0] for s in pybullet.getJointStates(self._machine, self._joint_indices, physicsClientId=cid)]) \
+            if self._joint_indices else ()
+        return twin.step_count, twin.time, values, tuple(poses), joints
+
+    def frame(self, raw: tuple | None = None) -> Frame:
+        step, t, values, poses, joints = raw if raw is not None else self.raw()
+        return Frame(step, t, values, np.asarray(poses, dtype=float).reshape(len(self.scene.bodies), 7),
+                     np.asarray(joints, dtype=float))
 
 
 class FramePublisher:

@@ -80,7 +80,7 @@ class Recorder:
         self.scene = self.observer.scene
         self.columns = columns_of(self.scene)
         self.rows_per_group = rows_per_group
-        self._rows: list[Frame] = []
+        self._rows: list[tuple] = []
         self._writer = None
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="recorder")
         self._pending = None
@@ -109,9 +109,9 @@ class Recorder:
     def after_step(self, twin) -> None:
         self.capture()
 
-    def capture(self, frame: Frame | None = None) -> None:
+    def capture(self) -> None:
         """Add the twin's present state as a row (the device does this after every step)."""
-        self._rows.append(frame if frame is not None else self.observer.frame())
+        self._rows.append(self.observer.raw())
         self.rows += 1
         if len(self._rows) >= self.rows_per_group:
             self._flush()
@@ -142,13 +142,13 @@ class Recorder:
             self._pending.result()  # one group at a time, in order; raises what the last write raised
         self._pending = self._pool.submit(self._write_group, rows)
 
-    def _write_group(self, rows: list[Frame]) -> None:
+    def _write_group(self, rows: list[tuple]) -> None:
+        """Rows (Observer.raw tuples) -> one row group (Parquet) or lines (CSV). Runs in the writer thread."""
         n_sig = len(self.scene.signals)
-        steps = [f.step for f in rows]
-        times = [f.time for f in rows]
-        values = list(zip(*(f.values for f in rows))) if n_sig else []
-        poses = np.stack([f.poses.ravel() for f in rows]) if rows[0].poses.size else np.empty((len(rows), 0))
-        joints = np.stack([f.joints for f in rows]) if rows[0].joints.size else np.empty((len(rows), 0))
+        steps, times, values, poses, joints = zip(*rows)
+        values = list(zip(*values)) if n_sig else []
+        poses = np.array(poses, dtype=float).reshape(len(rows), -1)
+        joints = np.array(joints, dtype=float).reshape(len(rows), -1)
         kinds = [t for _, t in self.columns[2:2 + n_sig]]
         if self._writer is not None:
             import pyarrow as pa
@@ -191,14 +191,16 @@ class Recorder:
         self.close()
 
 
+_ARROW_TYPES = {"bool": "bool_", "int64": "int64", "string": "string", "float64": "float64"}
+
+
 def _arrow_column(pa, col, kind):
-    if kind == "bool":
-        return pa.array([bool(v) for v in col], pa.bool_())
-    if kind == "int64":
-        return pa.array([int(v) for v in col], pa.int64())
-    if kind == "string":
-        return pa.array([str(v) for v in col], pa.string())
-    return pa.array([float(v) for v in col], pa.float64())
+    typ = getattr(pa, _ARROW_TYPES[kind])()
+    try:
+        return pa.array(col, typ)
+    except (pa.ArrowInvalid, pa.ArrowTypeError, TypeError):  # e.g. numpy scalars or ints among floats
+        conv = {"bool": bool, "int64": int, "string": str, "float64": float}[kind]
+        return pa.array([conv(v) for v in col], typ)
 
 
 def _csv_text(v, kind: str) -> str:

@@ -1,7 +1,7 @@
 """The `twin view`, `twin plot` and `twin snapshot` commands (added to `twin` by `add_commands`).
 
     twin view STATION [--host 127.0.0.1] [--port 8080] [--lockstep | --realtime [--speed X]] [--paused] [--record FILE]
-    twin view --replay FILE [--host 127.0.0.1] [--port 8080]
+    twin view --replay FILE [--at T] [--host 127.0.0.1] [--port 8080]
     twin plot FILE [SIGNAL ...] [-o plot.png|.svg]
     twin snapshot STATION|FILE [--at T] [-o cell.png] [--width W] [--height H]
 
@@ -55,6 +55,7 @@ def add_commands(sub) -> None:
     p.add_argument("--paused", action="store_true", help="real time: start paused (Run on the page starts it)")
     p.add_argument("--record", metavar="FILE", default=None, help="also record every step into FILE (.parquet or .csv)")
     p.add_argument("--replay", metavar="FILE", default=None, help="play a recording back, with a timeline")
+    p.add_argument("--at", type=float, default=None, metavar="T", help="--replay: start at simulated time T (s)")
     p.set_defaults(func=_view, lockstep=False)
 
     p = sub.add_parser("plot", help="plot signals of a recording against simulated time (PNG or SVG)",

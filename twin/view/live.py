@@ -91,30 +91,36 @@ class LiveControls:
 
 
 class LiveView:
-    """A page on a twin served by `bridge` and paced by `runner` (create it in the event loop's thread)."""
+    """A page on a twin served by `bridge` and paced by `runner` (create it in the event loop's thread).
 
-    def __init__(self, twin, bridge, runner, rmap, *, host: str = "127.0.0.1", port: int = 8080, fps: float = 30.0):
-        from .page import CellPage, FrameLoop
+    The page runs in its own process (`twin.view.process`); this process only publishes frames to it. The
+    log says `view on http://HOST:PORT` once the page is up."""
+
+    def __init__(self, twin, bridge, runner, rmap, *, host: str = "127.0.0.1", port: int = 8080, fps: float = 25.0):
+        from .process import PageProcess
 
         try:
             import viser  # noqa: F401
         except ImportError as exc:
             raise TwinError(f"the live view needs viser ({exc}): pip install 'gripper-twin[view]'") from None
-        self.twin = twin
+        self.twin, self.host = twin, host
         self.publisher = FramePublisher(twin)
         self.controls = LiveControls(self.publisher, bridge, runner, asyncio.get_running_loop(), rmap)
-        self.page = CellPage(self.publisher.scene, self.controls, host=host, port=port, fps=fps)
         attach(twin, self.publisher)
-        self.frames = FrameLoop(self.page, lambda: self.publisher.latest, fps=fps, before=self.publisher.request).start()
+        self.page = PageProcess(self.publisher, self.controls, host=host, port=port, fps=fps, on_ready=self._ready)
+
+    def _ready(self, page) -> None:
+        from twin.modbus.log import announce
+
+        announce(f"view on {self.url}")
 
     @property
     def url(self) -> str:
-        return f"http://{self.page.host}:{self.page.port}"
+        return f"http://{self.host}:{self.page.port}"
 
     def close(self) -> None:
-        self.frames.stop()
-        detach(self.twin, self.publisher)
         self.page.close()
+        detach(self.twin, self.publisher)
 
 
 # -- `twin serve --view/--record` ----------------------------------------------------------------------------------
@@ -145,8 +151,7 @@ def serve_front_ends(args):
             log(f"recording every step into {record}")
             stoppers.append(lambda: (rec.close(), log(f"recording: {rec.rows} rows in {record}")))
         if view is not None:
-            live = LiveView(twin, bridge, runner, rmap, host=args.view_host, port=view)
-            log(f"view on {live.url}")
+            live = LiveView(twin, bridge, runner, rmap, host=args.view_host, port=view)  # logs "view on URL"
             stoppers.append(live.close)
 
         def stop():
@@ -185,7 +190,6 @@ async def run_view(twin, rmap, *, host: str, port: int, lockstep: bool, speed: f
     live = LiveView(twin, bridge, runner, rmap, host=host, port=port)
     how = "lockstep (Step / Advance on the page)" if lockstep else f"real time x{speed:g}" + (", paused" if paused else "")
     log(f"station {twin.station.name!r}: {how}, step {twin.dt * 1000:g} ms")
-    log(f"view on {live.url}")
     if on_ready is not None:
         on_ready(live)
     task = asyncio.ensure_future(runner.run())
@@ -212,7 +216,7 @@ def cmd_view(args) -> int:
     if args.replay is not None:
         from .replay import run_replay
 
-        return run_replay(args.replay, host=args.host, port=args.port)
+        return run_replay(args.replay, host=args.host, port=args.port, at=args.at)
     if args.station is None:
         raise TwinError("twin view needs a STATION (or --replay FILE)")
     try:

@@ -23,13 +23,14 @@ from typing import Protocol
 
 import numpy as np
 
-from twin.observe import Frame, Scene, pose_matrix, setpoint_motion
+from twin.observe import Frame, Scene, matrix_to_quat, pose_matrix, setpoint_motion
 
 ENGINEERING = {"m": ("mm", 1000.0), "rad": ("deg", 180.0 / math.pi)}  # as the Modbus map and the PLC see them
 HIGHLIGHT = (40, 220, 90)  # the gripped part
 CONTACT, NO_CONTACT = (230, 30, 30), (120, 120, 120)
 FORCE_COLOUR = (250, 200, 0)
 GHOST_OPACITY = 0.3
+TABLE_HZ = 10.0  # the signal table's refresh rate (the 3D scene and the state line follow every frame)
 MIN_FORCE_SCALE = 0.0005  # m per N for the force arrows at least; more when the fingers are strong
 
 
@@ -82,7 +83,7 @@ class CellPage:
     """A viser server showing one cell. `show(frame)` from any thread; `close()` stops the server."""
 
     def __init__(self, scene: Scene, controls: Controls, *, host: str = "127.0.0.1", port: int = 8080,
-                 title: str | None = None, fps: float = 30.0):
+                 title: str | None = None, fps: float = 25.0):
         import viser
 
         self.scene, self.controls, self.fps = scene, controls, fps
@@ -99,6 +100,8 @@ class CellPage:
         self._body_index = {b: k for k, b in enumerate(scene.bodies)}
         self._setting = False
         self.frames_shown = 0
+        self._sent: dict = {}  # what each scene node last got (no message for what did not change)
+        self._table_due = 0.0  # the signal table and the inputs: at most TABLE_HZ times a second
         self._build_scene()
         self._build_panel()
 
@@ -289,10 +292,13 @@ class CellPage:
         # put the widget back to the signal's present value
         self._shown_inputs.pop(name, None)
         self._last_step = None
+        self._table_due = 0.0
 
     # -- showing a frame ---------------------------------------------------------------------------------------
     def show(self, frame: Frame, *, force: bool = False) -> None:
         """Bring the page up to `frame` (only what changed is sent)."""
+        if not force and not self.server.get_clients():
+            return  # nobody looks: send nothing (a browser that connects gets the scene as last sent, then this)
         with self._lock:
             state = self.controls.state()
             same = frame.step == self._last_step and not force
@@ -308,8 +314,7 @@ class CellPage:
         values = frame.as_signals(self.scene)
         for key, h in self._frames.items():
             p = frame.poses[self._body_index[key]]
-            h.position = (float(p[0]), float(p[1]), float(p[2]))
-            h.wxyz = _wxyz(p[3:7])
+            self._place(h, p[:3], p[3:7])
         gripped = values.get("GrippedPart") or ""
         for target in self.scene.targets:
             for h, rgb in self._meshes.get(target, []):
@@ -328,8 +333,11 @@ class CellPage:
             T = pose_matrix(frame.poses[self._body_index[link]])
             tip = T[:3, :3] @ offset + T[:3, 3]
             contact = bool(values.get(f"{f.name}.contact"))
-            self._markers[f.name].position = tuple(float(c) for c in tip)
-            self._markers[f.name].color = CONTACT if contact else NO_CONTACT
+            self._place(self._markers[f.name], tip, None)
+            colour = CONTACT if contact else NO_CONTACT
+            if self._sent.get(("colour", f.name)) != colour:
+                self._markers[f.name].color = colour
+                self._sent[("colour", f.name)] = colour
             arrow = self._arrows[f.name]
             if force > 1e-6 and f.chain:
                 cj = f.chain[0]
@@ -337,17 +345,33 @@ class CellPage:
                 axis = T[:3, :3] @ (axis / (np.linalg.norm(axis) or 1.0))
                 sign = self._push_sign(f, frame, setpoints)
                 end = tip + sign * axis * force * scale
-                arrow.points = np.array([[tip, end]], dtype=np.float32)
-                arrow.visible = True
+                points = np.array([[tip, end]], dtype=np.float32)
+                last = self._sent.get(("arrow", f.name))
+                if last is None or not np.array_equal(np.round(last, 4), np.round(points, 4)):
+                    arrow.points = points
+                    self._sent[("arrow", f.name)] = points
+                if not arrow.visible:
+                    arrow.visible = True
             elif arrow.visible:
                 arrow.visible = False
             G = setpoint_motion(f, self.scene, frame, setpoints)
             for link_key, h in self._ghosts.get(f.name, ()):
                 P = G @ pose_matrix(frame.poses[self._body_index[link_key]])
-                from twin.observe import matrix_to_quat
+                self._place(h, P[:3, 3], matrix_to_quat(P[:3, :3]))
 
-                h.position = tuple(float(c) for c in P[:3, 3])
-                h.wxyz = _wxyz(matrix_to_quat(P[:3, :3]))
+    def _place(self, handle, position, quat_xyzw) -> None:
+        """Move a scene node, sending nothing when it has not moved (most of the cell stands still)."""
+        key = id(handle)
+        pos = tuple(round(float(c), 6) for c in position)
+        rot = None if quat_xyzw is None else tuple(round(float(c), 6) for c in quat_xyzw)
+        last = self._sent.get(key)
+        if last is not None and last == (pos, rot):
+            return
+        self._sent[key] = (pos, rot)
+        if last is None or last[0] != pos:
+            handle.position = pos
+        if rot is not None and (last is None or last[1] != rot):
+            handle.wxyz = _wxyz(rot)
 
     def _push_sign(self, f, frame: Frame, setpoints: dict) -> float:
         """+1 when the finger's servo pushes along its joint axis (its setpoint lies ahead), -1 when against."""
@@ -362,10 +386,10 @@ class CellPage:
         mode = {"realtime": f"real time x{state.get('speed', 1.0):g}", "lockstep": "lockstep",
                 "replay": "replay"}.get(self.controls.mode, self.controls.mode)
         run = "paused" if state.get("paused") else ("running" if self.controls.mode == "realtime" else "")
-        text = (f"**t = {frame.time:.3f} s** &nbsp; step {frame.step} &nbsp; mode: {mode}"
+        text = (f"<span id='sim-state'><b>t = {frame.time:.3f} s</b> &nbsp; step {frame.step} &nbsp; mode: {mode}"
                 + (f" &nbsp; {run}" if run else "")
                 + (f" &nbsp; late steps: {state['late_steps']}" if state.get("late_steps") else "")
-                + (" &nbsp; **FAULT**" if state.get("fault") else ""))
+                + (" &nbsp; <b>FAULT</b>" if state.get("fault") else "") + "</span>")
         if text != self._last_state:
             self._state_md.content = text
             self._last_state = text
@@ -374,8 +398,10 @@ class CellPage:
             for name, b in self._buttons.items():
                 b.visible = name in buttons
             self._last_buttons = buttons
-        if same:
+        now = time.perf_counter()
+        if same or now < self._table_due:
             return
+        self._table_due = now + 1.0 / TABLE_HZ
         values = frame.as_signals(self.scene)
         rows = []
         for s in self.scene.signals:
@@ -442,7 +468,7 @@ def _load_mesh(path: str):
 class FrameLoop:
     """Calls `page.show(source())` `fps` times a second in a thread, until stopped."""
 
-    def __init__(self, page: CellPage, source, *, fps: float = 30.0, before=None):
+    def __init__(self, page: CellPage, source, *, fps: float = 25.0, before=None):
         self.page, self.source, self.period, self.before = page, source, 1.0 / fps, before
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="view-frames", daemon=True)

@@ -100,8 +100,8 @@ class ReplayControls:
         return self.rec.frame(self.index)
 
 
-def run_replay(path, *, host: str = "127.0.0.1", port: int = 8080, stop: threading.Event | None = None,
-               on_ready=None) -> int:
+def run_replay(path, *, host: str = "127.0.0.1", port: int = 8080, at: float | None = None,
+               stop: threading.Event | None = None, on_ready=None) -> int:
     from twin.core.errors import TwinError
 
     try:
@@ -114,6 +114,10 @@ def run_replay(path, *, host: str = "127.0.0.1", port: int = 8080, stop: threadi
 
     rec = Recording.open(path)
     controls = ReplayControls(rec)
+    if at is not None:
+        if not rec.time[0] - 1e-9 <= at <= rec.time[-1] + 1e-9:
+            raise TwinError(f"{rec.path}: --at {at:g} s is outside the recording ({rec.time[0]:g} to {rec.time[-1]:g} s)")
+        controls.seek_index(rec.index_at(at))
     page = CellPage(rec.scene, controls, host=host, port=port, title=f"replay: {rec.path.name}")
     loop = FrameLoop(page, controls.frame, before=controls.advance).start()
     announce(f"replaying {rec.path} ({len(rec)} steps, {rec.time[-1]:.3f} s)")

@@ -1,0 +1,58 @@
+"""`twin view --replay FILE` in a real browser: the recorded cell, a timeline to scrub and step."""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import ROOT, STATIONS
+from tests.view.conftest import signal_cell, view_url, wait_for_cell
+from twin.core import Twin
+from twin.recording import record
+
+
+@pytest.fixture(scope="module")
+def replay(tmp_path_factory):
+    pytest.importorskip("viser")
+    pytest.importorskip("pyarrow")
+    path = tmp_path_factory.mktemp("replay") / "grip.parquet"
+    with Twin.from_station(STATIONS / "smart_gripper") as twin, record(twin, path):
+        twin.step(5)
+        twin.write("jaw_left", twin.spec("jaw_left").min)
+        twin.step(70)
+    log = Path(tempfile.mkstemp(prefix="twin-replay-", suffix=".log")[1])
+    with open(log, "w") as err:
+        proc = subprocess.Popen([sys.executable, "-m", "twin", "view", "--replay", str(path), "--port", "0"], cwd=ROOT,
+                                stdout=subprocess.DEVNULL, stderr=err)
+    try:
+        yield view_url(log)
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+        log.unlink(missing_ok=True)
+
+
+def step_shown(page) -> int:
+    return int(re.search(r"step (\d+)", page.locator("#sim-state").inner_text()).group(1))
+
+
+def test_replay_steps_and_plays_the_recording(browser, replay):
+    page = browser.new_page(viewport={"width": 1000, "height": 700})
+    try:
+        page.goto(replay)
+        page.wait_for_selector("#sim-state", timeout=90000)
+        assert step_shown(page) == 0 and signal_cell(page, "doGripped") == "0"
+        page.get_by_role("button", name="Step", exact=True).click()
+        page.wait_for_function("() => /step 1\\b/.test(document.querySelector('#sim-state').textContent)",
+                               timeout=60000)
+        page.get_by_role("button", name="Run", exact=True).click()  # to the end: the jaws close and hold the cube
+        wait_for_cell(page, "doGripped", lambda t: t == "1", timeout=90)
+        page.wait_for_function("() => /step 75\\b/.test(document.querySelector('#sim-state').textContent)",
+                               timeout=90000)
+        assert signal_cell(page, "GrippedPart") == "cube"
+    finally:
+        page.close()
