@@ -16,7 +16,6 @@ import sys
 from pathlib import Path
 
 from twin.core.errors import SignalError, SignalRangeError, TwinError
-from twin.observe import FramePublisher, attach, detach
 
 
 def check_write(spec: dict, value) -> str | None:
@@ -43,7 +42,7 @@ def check_write(spec: dict, value) -> str | None:
 class LiveControls:
     """The page's handle on a running twin: state from the runner and bridge, writes and buttons via the loop."""
 
-    def __init__(self, publisher: FramePublisher, bridge, runner, loop: asyncio.AbstractEventLoop, rmap):
+    def __init__(self, publisher, bridge, runner, loop: asyncio.AbstractEventLoop, rmap):
         self.publisher, self.bridge, self.runner, self.loop, self.rmap = publisher, bridge, runner, loop, rmap
         self.mode = runner.mode
         self._specs = {s["name"]: s for s in publisher.scene.signals}
@@ -97,6 +96,8 @@ class LiveView:
     log says `view on http://HOST:PORT` once the page is up."""
 
     def __init__(self, twin, bridge, runner, rmap, *, host: str = "127.0.0.1", port: int = 8080, fps: float = 25.0):
+        from twin.observe import FramePublisher, attach
+
         from .process import PageProcess
 
         try:
@@ -119,6 +120,8 @@ class LiveView:
         return f"http://{self.host}:{self.page.port}"
 
     def close(self) -> None:
+        from twin.observe import detach
+
         self.page.close()
         detach(self.twin, self.publisher)
 

@@ -102,8 +102,16 @@ class CellPage:
         self.frames_shown = 0
         self._sent: dict = {}  # what each scene node last got (no message for what did not change)
         self._table_due = 0.0  # the signal table and the inputs: at most TABLE_HZ times a second
+        self._unseen: Frame | None = None
         self._build_scene()
         self._build_panel()
+
+        @self.server.on_client_connect
+        def _(client) -> None:
+            frame, self._unseen = self._unseen, None
+            if frame is not None:
+                self._table_due = 0.0
+                self.show(frame, force=True)
 
     # -- the 3D scene ---------------------------------------------------------------------------------------
     def _build_scene(self) -> None:
@@ -298,7 +306,8 @@ class CellPage:
     def show(self, frame: Frame, *, force: bool = False) -> None:
         """Bring the page up to `frame` (only what changed is sent)."""
         if not force and not self.server.get_clients():
-            return  # nobody looks: send nothing (a browser that connects gets the scene as last sent, then this)
+            self._unseen = frame  # nobody looks: send nothing; a browser that connects gets this frame
+            return
         with self._lock:
             state = self.controls.state()
             same = frame.step == self._last_step and not force
