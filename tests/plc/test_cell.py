@@ -13,6 +13,7 @@ import pytest
 
 from plc_client.cell_demo import CellDemo
 from tests.conftest import ROOT
+from tests.view.demo_report import check_demo_report
 
 CELL = ROOT / "stations" / "ring_rig_plc"
 
@@ -83,9 +84,9 @@ def test_a_missed_grip_raises_the_fault_and_the_robot_does_not_carry_on():
     assert s.fault_detected and s.exit_status == 0
 
 
-def test_the_demo_command_prints_its_steps_and_a_summary():
-    out = subprocess.run([sys.executable, "-m", "plc_client", "demo", "--cycles", "1", "--no-report"], cwd=ROOT,
-                         capture_output=True, text=True, timeout=300)
+def test_the_demo_command_prints_its_steps_and_a_summary(tmp_path):
+    out = subprocess.run([sys.executable, "-m", "plc_client", "demo", "--cycles", "1", "--report", str(tmp_path / "report")],
+                         cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.splitlines()
     assert any("robot: Cycle 1" in line for line in lines)
@@ -95,3 +96,4 @@ def test_the_demo_command_prints_its_steps_and_a_summary():
     assert re.search(r"cycle time\s+\d+\.\d+ s simulated, \d+\.\d+ s wall", summary)
     m = re.search(r"ring\s+(\d+\.\d) mm from its start", summary)
     assert m and float(m.group(1)) < 2.0
+    check_demo_report(out.stdout, tmp_path / "report")  # the report the demo ends with (tests/view)
