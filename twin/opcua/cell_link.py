@@ -22,7 +22,8 @@ class CellLink:
     def __init__(self, twin, bridge, runner=None):
         self.twin, self.bridge, self.runner = twin, bridge, runner
         self.server = None  # the OpcUaServer, once attached
-        self._names = tuple(s.name for s in twin.signals)
+        status = set(bridge._status())  # the runner's own values (sim.*, fault, comm.*): published by the bridge
+        self._names = tuple(s.name for s in twin.signals if s.name not in status)
         self._waiting: list[tuple[int, asyncio.Future]] = []
 
     def signals(self) -> tuple:
