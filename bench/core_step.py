@@ -2,7 +2,10 @@
 
     python -m bench core [--steps N]
 
-Table 1: steps per second of the shipped stations, headless, against real time (1 / step).
+Table 1: for every shipped station, the twin's step against the raw physics of the very same world (its
+`substeps` calls of pybullet's stepSimulation, nothing else), timed side by side in one run, alternating in
+rounds so that a noisy machine slows both alike: microseconds per step, the twin's overhead, and how many times
+real time each runs headless.
 Table 2: the four-finger gripper gripping its puck among N extra free cylinders of the target group,
 scattered on the floor. Per step: the whole step, and the grip check (contacts of every finger with the
 targets) done two ways side by side: ours (a broad-phase AABB query, then exact closest points only
@@ -11,22 +14,33 @@ against targets near a finger) and the naive one (closest points against every t
 from __future__ import annotations
 
 import argparse
+import statistics
 import tempfile
 import time
 from pathlib import Path
 
 STATIONS = Path(__file__).resolve().parent.parent / "stations"
+SHIPPED = sorted(p.parent.name for p in STATIONS.glob("*/station.toml"))
 
 
-def steps_per_second(station: Path, steps: int) -> tuple[float, float]:
+def twin_vs_physics(station: Path, steps: int, rounds: int = 5) -> dict[str, float]:
+    """Median us per step of the twin's step and of the raw physics of the same world, in alternating rounds."""
     from twin.core import Twin
 
     with Twin.from_station(station) as twin:
+        client, substeps = twin.world.client, twin.world.substeps
         twin.step(10)
-        t0 = time.perf_counter()
-        twin.step(steps)
-        elapsed = time.perf_counter() - t0
-        return steps / elapsed, 1.0 / twin.dt
+        twin_us, raw_us = [], []
+        for _ in range(rounds):
+            t0 = time.perf_counter()
+            twin.step(steps)
+            twin_us.append((time.perf_counter() - t0) / steps * 1e6)
+            t0 = time.perf_counter()
+            for _ in range(steps * substeps):
+                client.stepSimulation()
+            raw_us.append((time.perf_counter() - t0) / steps * 1e6)
+        twin_med, raw_med = statistics.median(twin_us), statistics.median(raw_us)
+        return {"twin": twin_med, "physics": raw_med, "dt": twin.dt}
 
 
 def crowded_station(folder: Path, extra: int) -> Path:
@@ -77,11 +91,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench core")
     parser.add_argument("--steps", type=int, default=300)
     args = parser.parse_args(argv)
-    print("Steps per second, headless (one step = servo commands + physics sub-steps + grip check)")
-    print(f"{'station':<16}{'steps/s':>10}{'real time':>12}{'x real time':>13}")
-    for name in ("ring_rig", "smart_gripper", "four_finger"):
-        rate, rt = steps_per_second(STATIONS / name, args.steps)
-        print(f"{name:<16}{rate:>10.0f}{rt:>12.1f}{rate / rt:>13.1f}")
+    print("The twin's step vs the raw physics of the same world (stepSimulation x substeps), headless, per step")
+    print(f"{'station':<16}{'physics us':>12}{'twin us':>10}{'twin/physics':>14}{'physics x rt':>14}{'twin x rt':>11}")
+    for name in SHIPPED:
+        r = twin_vs_physics(STATIONS / name, args.steps)
+        rt = r["dt"] * 1e6
+        print(f"{name:<16}{r['physics']:>12.0f}{r['twin']:>10.0f}{r['twin'] / r['physics']:>14.2f}"
+              f"{rt / r['physics']:>14.1f}{rt / r['twin']:>11.1f}")
     print()
     print("Grip check cost per step vs size of the target group (four_finger holding its puck)")
     print(f"{'targets':>8}{'step us':>10}{'check us (ours)':>17}{'check us (naive)':>18}{'naive/ours':>12}")

@@ -127,6 +127,8 @@ class GripSequence:
                     (fault `Fault.BAD_REQUEST`, `done` answers it, nothing is written) instead of sending a
                     setpoint the process would refuse
     handshake       the names of the handshake signals (`Handshake`)
+    press           once every force passes the threshold, move the setpoints on by this much (closing) before
+                    confirming: the holding force of a position servo (stiffness x how far past the part)
     """
 
     axes: tuple[str, ...]
@@ -148,6 +150,10 @@ class GripSequence:
     per_finger: bool | None = None
     travel: tuple[float, float] | None = None
     handshake: Handshake = field(default_factory=Handshake)
+    press: float = 0.0
+
+    def _within_travel(self, value: float) -> float:
+        return value if self.travel is None else min(max(value, self.travel[0]), self.travel[1])
 
     def __post_init__(self):
         if self.travel is not None:
@@ -291,6 +297,9 @@ class GripSequence:
     def _grip_scan(self, state: GripState, forces: list[float], actual: dict[str, float], elapsed: float,
                    now: float, touching: bool = True) -> None:
         if all(f >= self.threshold for f in forces) and touching:
+            if self.press:  # press on: a position servo's grip force grows with its setpoint past the part
+                close = self.close_direction[state.mode]
+                state.setpoint = {a: self._within_travel(v + close * self.press) for a, v in state.setpoint.items()}
             state.phase, state.held_at = Phase.HELD, dict(state.setpoint)
             state.forces_at_grip = dict(zip(self.forces, forces))
             return

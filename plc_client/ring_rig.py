@@ -28,6 +28,7 @@ def sequence(handshake: Handshake | None = None, **overrides) -> GripSequence:
                   ready_position={"outside": 330.0, "inside": 150.0},
                   release_limit={"outside": 441.0, "inside": 0.0},
                   travel=(0.0, 441.0),  # the axes' setpoint range (L2..L4: 0..441 mm)
+                  press=1.0,  # then 1 mm on: 1500 N per finger, and the ring is held by friction alone
                   handshake=handshake or Handshake())
     params.update(overrides)
     return GripSequence(**params)

@@ -34,7 +34,9 @@ def test_parallel_gripper_grips_the_cube_with_its_one_input_and_lets_go_when_ope
         assert twin.read("doGripped") and twin.read("GrippedPart") == "cube"
         # both jaws stopped on the 20 mm cube: the input's actual position is its half width
         assert twin.read("jaw_left.actual") == pytest.approx(0.010, abs=0.0015)
-        assert twin.read("jaw_left.force") >= 4.0  # pressing at its 5 N effort limit
+        # one 5 N motor drives both jaws through a 1:1 linkage: statics splits it, 2.5 N on each jaw
+        assert twin.read("jaw_left.force") + twin.read("jaw_right.force") == pytest.approx(5.0, rel=0.1)
+        assert twin.read("jaw_left.force") == pytest.approx(2.5, rel=0.1)
         twin.write("jaw_left", 0.025)
         settle(twin, 0.5)
         assert not twin.read("doGripped") and twin.read("GrippedPart") == ""
@@ -52,28 +54,37 @@ def test_parallel_gripper_set_to_11_mm_opens_each_jaw_to_11_mm():
         assert right == pytest.approx(0.011, abs=2e-4)  # the mimic jaw followed
 
 
-def test_four_fingers_grip_only_when_all_four_touch(four):
-    close_all(four, 0.0, ("F1", "F2", "F3"))
-    settle(four, 2.0)
-    contacts = four.finger_contacts()
-    assert all(contacts[f] == ("puck",) for f in ("F1", "F2", "F3")) and contacts["F4"] == ()
-    assert not four.read("doGripped")
-    four.write("F4", 0.0)
+def test_a_finger_at_its_setpoint_squeezed_by_the_others_reads_their_force(four):
+    four.write("F4", 0.040)  # F4 stands at the puck's side, F1 and F3 stay open: F2 pushes the puck against F4
+    four.write("F2", 0.0)
+    settle(four, 3.0)
+    # statics: F4 carries what F2's drive pushes with (its 40 N effort), less the floor's friction on the puck
+    assert four.read("F4.force") == pytest.approx(-four.read("F2.effort"), rel=0.1)
+    assert four.read("F4.force") == pytest.approx(40.0, rel=0.1) and four.read("F4.contact")
+    assert not four.read("doGripped")  # two fingers of four: no grip
+
+
+def test_four_fingers_grip_when_all_four_press_and_let_go_when_one_opens(four):
+    close_all(four, 0.0)
     settle(four, 2.0)
     assert four.read("doGripped") and four.read("GrippedPart") == "puck"
-    four.write("F2", 0.08)  # one finger lets go: the part is released
-    settle(four, 0.5)
+    close_all(four, 0.08)
+    settle(four, 1.0)
     assert not four.read("doGripped") and four.gripped_part == ""
 
 
-def test_contact_means_a_real_touch_not_a_finger_a_millimetre_away(four):
+def test_contact_turns_on_at_a_real_touch_never_before(four):
+    four.write("F3", 0.040)  # F3 stands at the puck's far side
     four.write("F1", 0.041)  # the puck's radius is 40 mm: the finger's face stops 1 mm short
     settle(four, 2.0)
     assert four.read("F1.actual") == pytest.approx(0.041, abs=2e-4)
     assert not four.read("F1.contact")
-    four.write("F1", 0.0402)  # 0.2 mm short: within the 0.5 mm contact distance
+    four.write("F1", 0.0402)  # 0.2 mm short: no contact, no force
     settle(four, 0.5)
-    assert four.read("F1.contact")
+    assert not four.read("F1.contact") and four.read("F1.force") == 0.0
+    four.write("F1", 0.0395)  # 0.5 mm past the puck's side: it presses the puck against F3
+    settle(four, 1.0)
+    assert four.read("F1.contact") and four.read("F1.force") > 0.0
 
 
 def test_servo_is_velocity_limited_and_stops_on_contact_with_force(four):
@@ -87,9 +98,9 @@ def test_servo_is_velocity_limited_and_stops_on_contact_with_force(four):
     settle(four, 2.0)
     assert four.read("F1.actual") == pytest.approx(0.04, abs=0.002)  # stopped on the puck, not at 0
     assert four.read("F1.force") > 10.0  # pressing (URDF effort 40 N)
-    four.write("F1", 0.08)
+    close_all(four, 0.08)
     settle(four, 1.5)
-    assert four.read("F1.force") < 1.0  # free again
+    assert four.read("F1.force") == 0.0  # free again
 
 
 def test_off_centre_part_is_pushed_to_the_centre_by_the_first_finger(tmp_path):

@@ -101,7 +101,7 @@ def test_plc_map_lists_the_names_with_table_address_unit_and_range(server):
     assert r.returncode == 0, r.stderr
     rows = {line.split()[0]: line.split() for line in r.stdout.splitlines()[2:]}
     assert rows["L2"] == ["L2", "holding_register", "16", "uint16", "mm", "0..441", "rw"]
-    assert rows["L2.force"][1:] == ["input_register", "21-22", "uint32", "N", "0..", "r"]
+    assert rows["L2.force"][1:] == ["input_register", "29-30", "uint32", "N", "0..", "r"]
 
 
 def test_plc_run_scans_user_logic_against_the_server_in_lockstep(server, client, tmp_path):

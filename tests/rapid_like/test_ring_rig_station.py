@@ -49,8 +49,8 @@ def test_the_program_carries_the_ring_right_to_left_and_back_in_physics():
             assert xy == pytest.approx(pallet, abs=0.003)
         # the outside grip closed from 330 mm onto the ring's 320 mm radius; the inside one opened to 200
         ao1 = [(e["t"], e["value"]) for e in events if e.get("signal") == "aoAxis1"]
-        assert [v for t, v in ao1 if t <= grips[0][0]][-1] == 320
-        assert [v for t, v in ao1 if grips[1][0] < t <= grips[2][0]][-1] == 200
+        assert [v for t, v in ao1 if t <= grips[0][0]][-1] == 319  # touching at 320, pressing (by force) at 319
+        assert [v for t, v in ao1 if grips[1][0] < t <= grips[2][0]][-1] == 201  # touching at 200, pressing at 201
         (x, y, z), q = twin.object_pose("ring")
         assert math.dist((x, y, z), (*RIGHT, 0.18)) < 0.005  # back where it started, lying flat
         assert abs(q[0]) < 0.01 and abs(q[1]) < 0.01
@@ -64,7 +64,7 @@ def test_init_waits_for_a_path_signal_like_the_io_simulator():
         twin.write("movePickOutside", True)
         run_until(twin, lambda: twin.read("doGripped"), 10.0)
         assert not twin.read("movePickOutside")  # Path_PickOutside resets its signal
-        assert twin.read("aoAxis1") == 320 and twin.read("L2") == pytest.approx(0.320)
+        assert twin.read("aoAxis1") == 319 and twin.read("L2") == pytest.approx(0.319)  # 1 mm past: pressing
         run_until(twin, lambda: twin.object_pose("ring")[0][2] > 0.5, 5.0)  # lifted to the approach
         assert twin.read("diGripped") and twin.read("GrippedPart") == "ring"
 

@@ -1,31 +1,38 @@
-"""The gripper's behaviour, evaluated every simulation step (the SmartComponent's OnSimulationStep).
+"""The gripper's behaviour, evaluated at every physics substep and after every simulation step.
 
-Before physics (`command`): each input is a servo setpoint. The joint moves towards it at its velocity
-limit with at most its effort limit (URDF velocity and effort, or the station's overrides), so it never
-jumps and it stops by itself against a part: unlike RobotStudio, each finger stops on contact and its
-force is known. Mimic joints are tied to their master by a gear constraint (a linkage, not a motor of their
-own). While a part is held (fixed to the base link) a joint presses towards it no further than 0.5 mm
-(0.005 rad) beyond where it gripped: it keeps its grip during fast moves but cannot sink into the part.
-While `Active` is low every joint holds its command.
+The drive model (docs/station-format.md, "Drives"). Every input is a servo drive:
+- its *command* moves towards the setpoint at the velocity limit (a ramp), and runs ahead of the joint by no more
+  than the error at which the drive reaches its force limit, so a new setpoint acts at once;
+- a position loop of stiffness K turns the following error e = command - actual into at most K * |e| (+ a
+  small holding force), limited by the effort: |F| <= min(effort, K |e| + HOLD_FRACTION * effort);
+- within that force it drives the joint at the command's speed plus the error taken out over a few substeps
+  (pybullet's implicit velocity motor: stable for any finger mass, as a stiff velocity loop is).
+A free finger follows its command with almost no force. A finger stopped by a part cannot follow: its error
+and so its force grow until the part's reaction balances them, the way a servo with finite stiffness presses;
+a finger pushed back by the others yields until K |e| carries the push. What the PLC reads is measured, not
+computed: `NAME.effort` is the motor force pybullet applied (averaged over the substeps), `NAME.force` the
+normal force of the finger's contacts on target objects (averaged over the substeps; a revolute finger's is the
+torque of those forces about its joint). Mimic joints are tied to their master by a gear constraint (one motor
+moves the whole linkage). Stepping by hand (fixedTimeStep = step / substeps, one stepSimulation per substep)
+keeps both motor limits and contact forces true (measured-facts.md: numSubSteps distorts both).
 
-The force of a joint is its servo's: a command position moves towards the setpoint at the velocity
-limit, the joint follows it, and the force is `effort * following error / FULL_FORCE_ERROR` (2 mm or
-0.02 rad), up to the effort limit. A free finger follows its command closely and reads almost nothing; a
-finger blocked by a part stops while its command runs on (no further than full force, so a new setpoint
-acts at once), and its force builds up to the effort limit, the way a real servo's torque builds when it
-presses on something. That is what a PLC's torque threshold reads. (pybullet's own motor force against a
-contact depends on its solver and the finger's mass, not on the effort: it is not what is reported. How
-far a finger sinks into a part, and so the force part-way up, still depends on the contact's softness.)
-
-After physics (`sense`): per finger, a contact flag (a real geometric contact: closest distance to a
-target object within `contact_distance`, 0.5 mm by default, never the early contacts pybullet reports
-within its collision margin) and its force: the largest servo force of the driven joints that carry it
-(its own joint, and e.g. the carriage a fine axis sits on). When every finger touches the same target, the target
-is fixed to the gripper's base link; when any finger loses it, it is released to physics again. This
-needs no setting for outside or inside grips: the rule is the same.
+The grip rule (`sense`, after each step), the same for outside and inside grips:
+- contact: a finger touches a target when their closest distance (with 0.1 mm collision margins, so corners
+  are sharp) is at most `contact_distance` (0 by default: never before true contact); in `friction` mode it
+  also has to press on it (a normal force);
+- `doGripped` / `GrippedPart`: every finger presses on the same target with at least `grip_force`; the grip
+  lasts while every finger presses with at least a quarter of it (a swinging part does not make it flicker);
+- `grip = "friction"`: nothing is welded, the part is held by friction alone and may slip or drop;
+  `grip = "attach"`: the part is fixed to the base link while every finger presses on it with at least
+  `attach_force`, released when any finger's force falls below it (the thesis's SmartComponent, honestly);
+- `slip`: a gripped part has moved more than `slip_distance` relative to the base link since it was gripped
+  (latched until the next grip);
+- `NAME.status` per finger, as a Robotiq gripper's object status: 0 moving towards the setpoint, 1 stopped by
+  contact while opening, 2 stopped by contact while closing, 3 at the setpoint.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import pybullet
@@ -33,87 +40,136 @@ import pybullet
 from .errors import SignalRangeError
 from .mechanism import JointInput, Mechanism
 from .station import GripperSpec
+from .world import COLLISION_MARGIN
 
 IN_POSITION_TOLERANCE = {"m": 0.0002, "rad": 0.002}  # 0.2 mm, ~0.1 degree
 MOVING_SPEED = {"m": 0.001, "rad": 0.005}  # below this the axis counts as standing still
 DEFAULT_VELOCITY = {"m": 0.1, "rad": 1.0}  # when the URDF gives no velocity limit
 DEFAULT_EFFORT = {"m": 100.0, "rad": 10.0}  # when the URDF gives no effort limit
-FULL_FORCE_ERROR = {"m": 0.002, "rad": 0.02}  # following error at which a servo applies its effort limit
-POSITION_GAIN = 0.3  # pybullet motor: the velocity it asks for is POSITION_GAIN * error / substep
-BLOCKED_ERROR = {"m": 0.0002, "rad": 0.002}  # lag beyond the motor's own that says a part holds the joint back
-BLOCKED_SPEEDUP = 20.0  # how much faster than its limit a held-back joint's motor may ask to move (it cannot)
-HOLD_PRESS = {"m": 0.0005, "rad": 0.005}  # a held part: how far beyond the grip position a joint may still press
+FULL_FORCE_ERROR = {"m": 0.001, "rad": 0.01}  # default stiffness: the effort limit at this following error
+HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
+POSITION_GAIN = 0.3  # the velocity loop takes this share of the following error out per substep
+SPEED_MARGIN = 1.0  # the drive never runs faster than its velocity limit (a lag is taken out at the end of a move)
+BLOCKED_SHARE = 0.25  # a drive standing with this share of its full-force error (or two substeps' travel) is held back
+BLOCKED_SPEEDUP = 20.0  # how much faster than its limit a held-back drive asks to move (it cannot: it presses)
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
+GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's drive effort
+RELEASE_SHARE = 0.25  # a grip lasts while every finger presses with this share of grip_force (no flicker)
+CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
+STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
 
 
 @dataclass
 class AxisState:
     actual: float = 0.0
     velocity: float = 0.0
-    force: float = 0.0
+    effort: float = 0.0  # the drive's applied force (N) or torque (N*m), signed along the joint axis
 
 
 @dataclass
 class FingerState:
-    contacts: tuple[str, ...] = ()  # target names within contact distance
-    force: float = 0.0  # magnitude of the force (N) or torque (N*m) of the finger's joint servo
+    contacts: tuple[str, ...] = ()  # targets it touches (and, in friction mode, presses on)
+    force: float = 0.0  # normal force on target objects (N), or its torque about a revolute finger's joint (N*m)
+    pressing: dict[str, float] = field(default_factory=dict)  # target -> that force, per target
+    status: int = STATUS_AT_SETPOINT
 
 
 @dataclass
 class GripState:
-    gripped: str = ""  # the target fixed to the base link, "" for none
+    gripped: str = ""  # every finger presses on it with at least grip_force ("" for none)
+    attached: str = ""  # attach mode: the target fixed to the base link
+    slip: bool = False
+    slip_distance: float = 0.0  # m: how far the gripped part has moved relative to the base link since the grip
     axes: dict[str, AxisState] = field(default_factory=dict)
     fingers: dict[str, FingerState] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class Drive:
+    """One input's servo drive: velocity limit, force limit, stiffness (see the module docstring)."""
+
+    velocity: float
+    effort: float
+    stiffness: float
+
+    @property
+    def full_error(self) -> float:
+        """The following error at which the drive reaches its force limit."""
+        return self.effort / self.stiffness
+
+
 class Gripper:
-    """Servoes the gripper's joints and decides grip and release from finger contacts."""
+    """Servoes the gripper's joints, measures forces and contacts, and decides grip, slip and release."""
 
     def __init__(self, client, body: int, joint_index: dict[str, int], link_index: dict[str, int],
-                 mechanism: Mechanism, spec: GripperSpec, targets: dict[str, int]):
+                 mechanism: Mechanism, spec: GripperSpec, targets: dict[str, int], substep: float):
         self.client, self.body, self.mechanism, self.spec = client, body, mechanism, spec
         self.targets = targets  # target name -> body id, in station order
         self._target_by_id = {uid: name for name, uid in targets.items()}
         self.base_link = link_index[mechanism.base_link]
+        self.h = substep
+        self.names = [inp.name for inp in mechanism.inputs]
         self.joint = {inp.name: joint_index[inp.joint] for inp in mechanism.inputs}
-        self.limits: dict[str, tuple[float, float]] = {}
+        self._joint_ids = [self.joint[n] for n in self.names]
+        self.unit = {inp.name: inp.unit for inp in mechanism.inputs}
+        self.drives: dict[str, Drive] = {}
         for inp in mechanism.inputs:
             o = spec.joints.get(inp.name)
             velocity = (o.velocity if o and o.velocity else None) or inp.velocity or DEFAULT_VELOCITY[inp.unit]
             effort = (o.effort if o and o.effort else None) or inp.effort or DEFAULT_EFFORT[inp.unit]
-            self.limits[inp.name] = (velocity, effort)
+            stiffness = (o.stiffness if o and o.stiffness else None) or effort / FULL_FORCE_ERROR[inp.unit]
+            self.drives[inp.name] = Drive(velocity, effort, stiffness)
         master_input = {inp.joint: inp.name for inp in mechanism.inputs}
         self.mimics = [(joint_index[m.joint], master_input[m.master], m.multiplier, m.offset) for m in mechanism.mimics]
         self.finger_links = {f.name: [link_index[n] for n in f.links] for f in mechanism.fingers}
-        # the servos (inputs) that drive each finger: those of the joints that carry it, a mimic joint's being
-        # its master's (a linkage has one motor); a finger presses with the servos behind it
+        self._finger_of_link = {link: f for f, links in self.finger_links.items() for link in links}
+        self.finger_joint = {f.name: joint_index[f.joint] for f in mechanism.fingers}
         servo_of = {j: name for name, j in self.joint.items()} | {j: master for j, master, _, _ in self.mimics}
+        # the servos (inputs) that drive each finger, nearest first: its own joint's (or its master's), then those
+        # of the joints that carry it (e.g. the carriage a fine axis sits on)
         self.finger_servos = {f.name: list(dict.fromkeys(servo_of[j] for j in self._chain(joint_index[f.joint])
                                                           if j in servo_of))
                               for f in mechanism.fingers}
+        self.revolute_fingers = {f.name for f in mechanism.fingers
+                                 if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
+        self.grip_force = {f: spec.grip_force if spec.grip_force is not None
+                           else GRIP_FORCE_FRACTION * min((self.drives[s].effort for s in servos), default=1.0)
+                           for f, servos in self.finger_servos.items()}
+        self._release_force = {f: RELEASE_SHARE * force for f, force in self.grip_force.items()}
+        self.attach_force = {f: spec.attach_force if spec.attach_force is not None else self.grip_force[f]
+                             for f in self.finger_servos}
         self.active_input = spec.always_active  # the `Active` input as last written
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
-        self.unit = {inp.name: inp.unit for inp in mechanism.inputs}
-        params = client.getPhysicsEngineParameters()
-        self.dt = float(params["fixedTimeStep"])
-        # how far pybullet's motor trails a target moving at 1 unit/s: it asks for POSITION_GAIN * error / h
-        self._lag_per_speed = self.dt / max(1, int(params["numSubSteps"])) / POSITION_GAIN
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
-        self._held_at: dict[str, tuple[float, float]] = {}  # while a part is held: input -> (position, pressing sign)
-        self.state = GripState()
+        self._grip_reference: tuple | None = None  # the gripped part's pose in the base link's frame at the grip
+        self._slip_part = ""
         for inp in mechanism.inputs:
             client.resetJointState(body, self.joint[inp.name], self.setpoint[inp.name])
         for joint, master, mult, off in self.mimics:
             client.resetJointState(body, joint, mult * self.setpoint[master] + off)
+        self.closing = self._closing_directions()
+        for joint, master, mult, off in self.mimics:
             self._couple(joint, master, mult, off)
+        self._mesh_links: set[int] = set()
         for links in self.finger_links.values():
             for link in links:
                 client.changeDynamics(body, link, lateralFriction=spec.friction)
+                client.changeDynamics(body, link, collisionMargin=COLLISION_MARGIN)  # (in one call pybullet drops the friction)
+                shapes = client.getCollisionShapeData(body, link)
+                if any(s[2] == pybullet.GEOM_MESH for s in shapes):
+                    self._mesh_links.add(link)  # a hull's margin lies outside it: its distances read short
+        # pybullet_utils' client looks every function up anew on each call: the per-substep ones are bound once
+        self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
+        self._contact_points = client.getContactPoints
+        self._quiet = False
+        self.state = GripState()
+        self._reset_sums()
         self.sense()
 
+    # -- inputs -------------------------------------------------------------------------------------------
     def _initial(self, inp: JointInput) -> float:
         value = self.spec.initial.get(inp.name, min(max(0.0, inp.min), inp.max))
         self.check(inp, value)
@@ -132,15 +188,20 @@ class Gripper:
         self.check(inp, value)
         self.setpoint[name] = float(value)
 
+    @property
+    def limits(self) -> dict[str, tuple[float, float]]:
+        """Each input's (velocity, effort) limits as applied now."""
+        return {name: (d.velocity, d.effort) for name, d in self.drives.items()}
+
     def set_limits(self, name: str, velocity: float | None = None, effort: float | None = None) -> None:
         """Change an input's velocity or effort limit from the next step on (a drive that loses force, a
-        slower axis: fault injection and parameter studies). None keeps the present value."""
-        old_velocity, old_effort = self.limits[self.mechanism.input(name).name]
+        slower axis: fault injection and parameter studies); its stiffness stays. None keeps the present value."""
+        d = self.drives[self.mechanism.input(name).name]
         for what, value in (("velocity", velocity), ("effort", effort)):
             if value is not None and not (value >= 0.0 and value < float("inf")):
                 raise ValueError(f"{name}: the {what} limit must be a finite number >= 0, not {value!r}")
-        self.limits[name] = (old_velocity if velocity is None else float(velocity),
-                             old_effort if effort is None else float(effort))
+        self.drives[name] = Drive(d.velocity if velocity is None else float(velocity),
+                                  d.effort if effort is None else float(effort), d.stiffness)
 
     def set_active(self, active: bool) -> None:
         """Store the `Active` input; an always-active gripper keeps what was written but ignores it."""
@@ -150,53 +211,7 @@ class Gripper:
     def active(self) -> bool:
         return self.active_input or self.spec.always_active
 
-    def command(self) -> None:
-        """Send this step's servo commands (before physics): move each command position on by at most the
-        velocity limit, and let each servo push with the force its following error calls for."""
-        if not self.active and self._hold is None:
-            self._hold = dict(self.command_position)
-        elif self.active:
-            self._hold = None
-        goal = self._hold if self._hold is not None else self.setpoint
-        c, dt = self.client, self.dt
-        for name, joint in self.joint.items():
-            velocity, effort = self.limits[name]
-            full = FULL_FORCE_ERROR[self.unit[name]]
-            target = _towards(self.command_position[name], goal[name], velocity * dt)
-            actual, joint_speed = c.getJointState(self.body, joint)[:2]
-            # a blocked joint's command runs on only as far as full force: a new setpoint acts at once
-            target = min(max(target, actual - full), actual + full)
-            # and a joint already further on its way than its command (leaving a part) pulls the command along
-            ahead = (actual - target) * (goal[name] - target)
-            if ahead > 0:
-                target = actual if abs(goal[name] - target) > abs(actual - target) else goal[name]
-            speed = abs(target - self.command_position[name]) / dt
-            self.command_position[name] = target
-            # a joint held back by a part (its lag beyond what its speed explains) may press with its whole effort:
-            # pybullet's motor only pushes as hard as the velocity it asks for allows, so let it ask for more
-            blocked = (abs(target - actual) > speed * self._lag_per_speed + BLOCKED_ERROR[self.unit[name]]
-                       and abs(joint_speed) < MOVING_SPEED[self.unit[name]])  # standing: not merely lagging
-            self._drive(joint, self._press_limit(name, target), velocity * (BLOCKED_SPEEDUP if blocked else 1.0), effort)
-
-    def _couple(self, joint: int, master: str, mult: float, off: float) -> None:
-        """Tie a mimic joint to its master as a mechanism does (a gear constraint: joint = mult * master + off),
-        with no motor of its own: the master's servo moves the whole linkage, and a part pushing one coupled
-        finger pushes them all (a self-centring chuck centres its part)."""
-        c = self.client
-        c.setJointMotorControl2(self.body, joint, pybullet.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0)
-        gear = c.createConstraint(self.body, joint, self.body, self.joint[master], pybullet.JOINT_GEAR,
-                                  [0, 0, 1], [0, 0, 0], [0, 0, 0])
-        # the constraint holds q_joint + gearRatio * q_master = relativePositionTarget
-        c.changeConstraint(gear, gearRatio=-mult, relativePositionTarget=off, erp=MIMIC_ERP,
-                           maxForce=MIMIC_FORCE_FACTOR * self.limits[master][1] * max(1.0, abs(mult)))
-
-    def _force(self, name: str, actual: float, joint_speed: float) -> float:
-        """The servo force of input `name` after the step: effort * following error / full-force error. The lag
-        that a joint moving at its speed has behind its command (the motor's, not a load's) does not count; a
-        joint held by a part stands, so all of its error does."""
-        error = max(0.0, abs(self.command_position[name] - actual) - abs(joint_speed) * self._lag_per_speed)
-        return self.limits[name][1] * min(1.0, error / FULL_FORCE_ERROR[self.unit[name]])
-
+    # -- set-up ---------------------------------------------------------------------------------------------
     def _chain(self, joint: int) -> list[int]:
         """`joint` and the joints between it and the body's base, nearest first."""
         chain = []
@@ -205,87 +220,269 @@ class Gripper:
             joint = self.client.getJointInfo(self.body, joint)[16]  # the parent link's (= its joint's) index
         return chain
 
-    def _press_limit(self, name: str, target: float) -> float:
-        """While a part is fixed to the base link, a joint goes no further towards it than HOLD_PRESS beyond where
-        it held it when it was fixed: it keeps pressing (a carried part stays between the fingers) but cannot
-        sink on into the fixed part. Its command, and so its force, builds as before. Moving the
-        other way (opening a grip) is not held back."""
-        if name not in self._held_at:
-            return target
-        held, sign = self._held_at[name]
-        reach = held + sign * HOLD_PRESS[self.unit[name]]
-        return min(target, reach) if sign > 0 else max(target, reach)
+    def _closing_directions(self) -> dict[str, float]:
+        """Per input, +1 or -1: the way that brings the fingers together (their spread about their common centre
+        shrinks), found by moving each input a little in the loaded world and putting it back."""
+        c, body = self.client, self.body
+        links = [links[0] for links in self.finger_links.values() if links]
+        if not links:
+            return {n: -1.0 for n in self.names}
 
-    def _drive(self, joint: int, target: float, velocity: float, effort: float) -> None:
-        """Command one joint towards its command position with at most its effort limit. (pybullet's motor is an
-        implicit velocity constraint: stable for any finger mass, and it holds a carried part with the full
-        effort; the force it reaches against a contact grows with the velocity it asks for.)"""
-        self.client.setJointMotorControl2(self.body, joint, pybullet.POSITION_CONTROL, targetPosition=target,
-                                          force=effort, maxVelocity=velocity, positionGain=POSITION_GAIN, velocityGain=1.0)
+        def points():
+            pts = [c.getLinkState(body, link, computeForwardKinematics=True)[0] for link in links]
+            if len(pts) == 1:  # one finger: its distance from the base (a jaw closing on a fixed one)
+                pts.append(c.getBasePositionAndOrientation(body)[0] if self.base_link < 0
+                           else c.getLinkState(body, self.base_link, computeForwardKinematics=True)[0])
+            return pts
 
-    def _touching(self, finger: str) -> tuple[str, ...]:
-        c, d = self.client, self.spec.contact_distance
+        def spread(pts, centre):
+            return sum(math.dist(p, centre) for p in pts)
+
+        pts = points()
+        centre = [sum(p[i] for p in pts) / len(pts) for i in range(3)]
+        base = spread(pts, centre)
+        result = {}
+        for name in self.names:
+            inp = self.mechanism.input(name)
+            q = self.setpoint[name]
+            delta = (0.001 if inp.unit == "m" else 0.01) * (1 if q + 0.001 <= inp.max else -1)
+            self._set_input(name, q + delta)
+            moved = spread(points(), centre) - base
+            self._set_input(name, q)
+            result[name] = (-1.0 if moved > 0 else 1.0) * (1 if delta > 0 else -1)
+        return result
+
+    def _set_input(self, name: str, q: float) -> None:
+        c = self.client
+        c.resetJointState(self.body, self.joint[name], q)
+        for joint, master, mult, off in self.mimics:
+            if master == name:
+                c.resetJointState(self.body, joint, mult * q + off)
+
+    def _couple(self, joint: int, master: str, mult: float, off: float) -> None:
+        """Tie a mimic joint to its master as a mechanism does (a gear constraint: joint = mult * master + off),
+        with no motor of its own: the master's drive moves the whole linkage, and a part pushing one coupled
+        finger pushes them all (a self-centring chuck centres its part)."""
+        c = self.client
+        c.setJointMotorControl2(self.body, joint, pybullet.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0)
+        gear = c.createConstraint(self.body, joint, self.body, self.joint[master], pybullet.JOINT_GEAR,
+                                  [0, 0, 1], [0, 0, 0], [0, 0, 0])
+        # the constraint holds q_joint + gearRatio * q_master = relativePositionTarget
+        c.changeConstraint(gear, gearRatio=-mult, relativePositionTarget=off, erp=MIMIC_ERP,
+                           maxForce=MIMIC_FORCE_FACTOR * self.drives[master].effort * max(1.0, abs(mult)))
+
+    # -- every substep ------------------------------------------------------------------------------------
+    def _reset_sums(self) -> None:
+        self._n = 0
+        self._effort_sum = [0.0] * len(self.names)
+        self._force_sum: dict[tuple[str, int], float] = {}
+
+    def drive(self, substep: int = 0) -> None:
+        """Before a physics substep: move each command on along its ramp and set each drive's velocity and force.
+        Drives that all stand still at their goal, pressing on nothing, keep the first substep's settings for the
+        rest of the step: nothing changes there but cost."""
+        if substep and self._quiet:
+            return
+        if not self.active and self._hold is None:
+            self._hold = dict(self.command_position)
+        elif self.active:
+            self._hold = None
+        goal = self._hold if self._hold is not None else self.setpoint
+        h = self.h
+        states = self._joint_states(self.body, self._joint_ids)
+        velocities, forces = [], []
+        quiet = True
+        for name, (actual, joint_speed, _, _) in zip(self.names, states):
+            d = self.drives[name]
+            before = self.command_position[name]
+            target = _towards(before, goal[name], d.velocity * h)
+            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
+            full = d.full_error
+            target = min(max(target, actual - full), actual + full)
+            self.command_position[name] = target
+            error = target - actual
+            limit = SPEED_MARGIN * d.velocity
+            speed = min(max((target - before) / h + POSITION_GAIN * error / h, -limit), limit)
+            if abs(error) > max(BLOCKED_SHARE * full, 2 * d.velocity * h) and abs(joint_speed) < MOVING_SPEED[self.unit[name]]:
+                # held back by a part: pybullet's solver builds a motor's force only as fast as the velocity it asks
+                # for, so a held-back drive asks for far more; its force limit is then what it presses with
+                speed = BLOCKED_SPEEDUP * d.velocity * (1.0 if error > 0 else -1.0)
+            velocities.append(speed)
+            forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
+            quiet = (quiet and before == goal[name] and abs(joint_speed) < MOVING_SPEED[self.unit[name]]
+                     and abs(error) < BLOCKED_SHARE * full)  # a drive pressing on a part is followed every substep
+        self._quiet = quiet
+        self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities, forces=forces)
+
+    def measure(self) -> None:
+        """After a physics substep: add up the drives' applied forces and the fingers' contact forces."""
+        self._n += 1
+        for i, s in enumerate(self._joint_states(self.body, self._joint_ids)):
+            self._effort_sum[i] += s[3]
+        sums, finger_of, contact_points = self._force_sum, self._finger_of_link, self._contact_points
+        for uid in self.targets.values():
+            for pt in contact_points(self.body, uid):
+                finger = finger_of.get(pt[3])
+                if finger is None or pt[9] <= 0.0:
+                    continue
+                if finger in self.revolute_fingers:
+                    force = abs(self._torque(finger, pt))
+                else:
+                    force = pt[9]
+                key = (finger, uid)
+                sums[key] = sums.get(key, 0.0) + force
+
+    def _torque(self, finger: str, pt) -> float:
+        """The torque about a revolute finger's joint axis of one contact's normal force on the part."""
+        c = self.client
+        joint = self.finger_joint[finger]
+        info = c.getJointInfo(self.body, joint)
+        link = c.getLinkState(self.body, joint)
+        origin, orn = link[4], link[5]  # the child link's URDF frame: the joint's frame
+        axis = _rotate(orn, info[13])
+        r = [pt[5][i] - origin[i] for i in range(3)]
+        f = [-pt[7][i] * pt[9] for i in range(3)]  # the normal on B points at A (the finger): the force on B is -n
+        tau = (r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0])
+        return sum(tau[i] * axis[i] for i in range(3))
+
+    # -- after each step --------------------------------------------------------------------------------------
+    def sense(self) -> None:
+        """Read joints, efforts and contacts after physics; decide grip, attachment, slip and status."""
+        c, n = self.client, max(1, self._n)
+        axes = {}
+        for i, (name, s) in enumerate(zip(self.names, c.getJointStates(self.body, self._joint_ids))):
+            axes[name] = AxisState(s[0], s[1], self._effort_sum[i] / n if self._n else 0.0)
+        self.state.axes = axes
+        pressing: dict[str, dict[str, float]] = {f: {} for f in self.finger_links}
+        for (finger, uid), total in self._force_sum.items():
+            pressing[finger][self._target_by_id[uid]] = total / n
+        friction = self.spec.grip == "friction"
+        fingers = {}
+        for finger in self.finger_links:
+            touching = self._touching(finger, CONTACT_SLACK if friction else 0.0)
+            on = {t: pressing[finger].get(t, 0.0) for t in self.targets if pressing[finger].get(t, 0.0) > 0.0}
+            contacts = tuple(t for t in touching if not friction or t in on)
+            force = sum(on.values())
+            fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
+        self.state.fingers = fingers
+        self._reset_sums()
+
+        held = self.state.gripped
+        if held and self._pressed_by_all(self._release_force, held):
+            gripped = [held]  # hysteresis: a grip lasts while every finger presses with a quarter of the grip force
+        else:
+            gripped = self._pressed_by_all(self.grip_force)
+        if self.spec.grip == "attach":
+            held = self.state.attached
+            if held and held not in self._pressed_by_all(self.attach_force, held):
+                self._release()
+            if not self.state.attached:
+                candidates = self._pressed_by_all(self.attach_force)
+                if candidates:
+                    self._attach(candidates[0])
+        newly = gripped[0] if gripped else ""
+        if newly and newly != self.state.gripped:
+            self._grip_reference = (newly, self._relative_pose(newly))
+            self._slip_part, self.state.slip, self.state.slip_distance = newly, False, 0.0
+        self.state.gripped = newly
+        self._watch_slip()
+
+    def _pressed_by_all(self, threshold: dict[str, float], only: str | None = None) -> list[str]:
+        """The targets (station order) every finger presses on with at least its threshold force."""
+        fingers = self.state.fingers
+        if not fingers:
+            return []
+        names = [only] if only else list(self.targets)
+        return [t for t in names if all(t in f.contacts and f.pressing.get(t, 0.0) >= threshold[name]
+                                        for name, f in fingers.items())]
+
+    def _touching(self, finger: str, slack: float = 0.0) -> tuple[str, ...]:
+        """Targets within contact_distance (+ slack) of the finger's true shape (never before they touch)."""
+        c, d = self.client, max(self.spec.contact_distance, slack)
         found: set[str] = set()
         for link in self.finger_links[finger]:
             lo, hi = c.getAABB(self.body, link)
-            nearby = c.getOverlappingObjects([v - d for v in lo], [v + d for v in hi]) or ()
+            nearby = c.getOverlappingObjects([v - d - COLLISION_MARGIN for v in lo], [v + d + COLLISION_MARGIN for v in hi]) or ()
+            limit = d - (COLLISION_MARGIN if link in self._mesh_links else 0.0)
             for uid in {uid for uid, _ in nearby if uid in self._target_by_id}:
-                points = c.getClosestPoints(self.body, uid, d, linkIndexA=link)
-                if any(pt[8] <= d for pt in points):
+                points = c.getClosestPoints(self.body, uid, d + COLLISION_MARGIN, linkIndexA=link)
+                if any(pt[8] <= limit for pt in points):
                     found.add(self._target_by_id[uid])
         return tuple(name for name in self.targets if name in found)
 
-    def sense(self) -> None:
-        """Read joints and contacts after physics, then attach or release (the grip rule)."""
-        c = self.client
-        axes = {}
-        for name, joint in self.joint.items():
-            pos, vel, _, _ = c.getJointState(self.body, joint)
-            axes[name] = AxisState(pos, vel, self._force(name, pos, vel))
-        fingers = {}
-        for finger, servos in self.finger_servos.items():
-            force = max((axes[name].force for name in servos), default=0.0)
-            fingers[finger] = FingerState(self._touching(finger), force)
-        self.state.axes, self.state.fingers = axes, fingers
-        common = set(self.targets)
-        for f in fingers.values():
-            common &= set(f.contacts)
-        if not fingers:
-            common = set()
-        gripped = self.state.gripped
-        if gripped and gripped not in common:
-            self._release()
-        if not self.state.gripped and common:
-            self._attach(next(name for name in self.targets if name in common))
+    def _status(self, finger: str, axes: dict[str, AxisState], contact: bool) -> int:
+        """The finger's object status, Robotiq's way, from its own drive (the nearest servo that moves it)."""
+        servos = self.finger_servos[finger]
+        if not servos:
+            return STATUS_AT_SETPOINT
+        name = servos[0]
+        goal = self._hold[name] if self._hold is not None else self.setpoint[name]
+        axis, unit = axes[name], self.unit[name]
+        if abs(goal - axis.actual) <= IN_POSITION_TOLERANCE[unit]:
+            return STATUS_AT_SETPOINT
+        d = self.drives[name]
+        blocked = abs(axis.velocity) <= MOVING_SPEED[unit] and (
+            contact or abs(self.command_position[name] - axis.actual) >= 0.5 * d.full_error)
+        if not blocked:
+            return STATUS_MOVING
+        closing = (goal - axis.actual) * self.closing[name] > 0
+        return STATUS_CLOSING_CONTACT if closing else STATUS_OPENING_CONTACT
 
+    # -- slip -----------------------------------------------------------------------------------------------
+    def _base_pose(self):
+        c = self.client
+        if self.base_link == -1:
+            return c.getBasePositionAndOrientation(self.body)
+        return c.getLinkState(self.body, self.base_link, computeForwardKinematics=True)[:2]  # (its centre of mass frame, now)
+
+    def _relative_pose(self, name: str):
+        c = self.client
+        base_pos, base_orn = self._base_pose()
+        obj_pos, obj_orn = c.getBasePositionAndOrientation(self.targets[name])
+        inv_pos, inv_orn = c.invertTransform(base_pos, base_orn)
+        return c.multiplyTransforms(inv_pos, inv_orn, obj_pos, obj_orn)
+
+    def _watch_slip(self) -> None:
+        """While a part is gripped, or still pressed by a finger after its grip was lost (it is sliding out): how
+        far it has moved relative to the base link since the grip; beyond slip_distance `slip` is raised, and it
+        stays raised until the next grip."""
+        if self._grip_reference is None:
+            return
+        name, (ref_pos, _) = self._grip_reference
+        if self.state.gripped != name and not any(name in f.pressing for f in self.state.fingers.values()):
+            self._grip_reference = None  # let go (or fallen clear): nothing more to watch
+            return
+        self.state.slip_distance = math.dist(self._relative_pose(name)[0], ref_pos)
+        if self.state.slip_distance > self.spec.slip_distance:
+            self.state.slip = True
+
+    # -- attach mode ----------------------------------------------------------------------------------------
     def _attach(self, name: str) -> None:
         c, uid = self.client, self.targets[name]
-        if self.base_link == -1:
-            base_pos, base_orn = c.getBasePositionAndOrientation(self.body)
-        else:
-            base_pos, base_orn = c.getLinkState(self.body, self.base_link)[:2]  # the link's centre of mass frame
-        obj_pos, obj_orn = c.getBasePositionAndOrientation(uid)
-        inv_pos, inv_orn = c.invertTransform(base_pos, base_orn)
-        rel_pos, rel_orn = c.multiplyTransforms(inv_pos, inv_orn, obj_pos, obj_orn)
+        rel_pos, rel_orn = self._relative_pose(name)
         self._constraint = c.createConstraint(self.body, self.base_link, uid, -1, pybullet.JOINT_FIXED, [0, 0, 0],
                                               rel_pos, [0, 0, 0], rel_orn, [0, 0, 0, 1])
         c.changeConstraint(self._constraint, maxForce=1e6)
-        self.state.gripped = name
-        # where each joint holds the part, and which way it was heading (towards the part)
-        goal = self._hold if self._hold is not None else self.setpoint
-        self._held_at = {}
-        for inp, joint in self.joint.items():
-            actual = c.getJointState(self.body, joint)[0]
-            heading = goal[inp] - actual
-            if abs(heading) > 1e-9:
-                self._held_at[inp] = (actual, 1.0 if heading > 0 else -1.0)
+        self.state.attached = name
 
     def _release(self) -> None:
         if self._constraint is not None:
             self.client.removeConstraint(self._constraint)
         self._constraint = None
-        self.state.gripped = ""
-        self._held_at = {}
+        self.state.attached = ""
+
+    def forget(self, name: str) -> None:
+        """A target taken out of the cell: it is no longer attached, gripped or watched."""
+        if self.state.attached == name:
+            self._release()
+        if self._grip_reference is not None and self._grip_reference[0] == name:
+            self._grip_reference = None
+
+
+def _rotate(orn, v):
+    m = pybullet.getMatrixFromQuaternion(orn)
+    return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
+            m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
 
 
 def _towards(value: float, goal: float, step: float) -> float:

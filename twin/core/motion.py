@@ -30,6 +30,10 @@ SAMPLE_STEP = 0.005
 SAMPLE_ANGLE = math.radians(0.5)
 #: Between two neighbouring samples no axis may jump more than this (a configuration flip).
 MAX_JOINT_JUMP = math.radians(5.0)
+#: The TCP's peak acceleration (m/s^2): a fast move's ramp is lengthened to keep within it, as a controller
+#: limits a heavily loaded arm (a 0.2 s ramp to a MoveJ's 3.4 m/s would be 27 m/s^2, more than any gripper's
+#: friction holds a heavy part through).
+MAX_TCP_ACCELERATION = 10.0
 #: MoveC: the three points must be this far apart and not within 0.06 degrees of one line.
 MIN_CIRCLE_POINT_DISTANCE = 0.001
 
@@ -176,7 +180,21 @@ def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callabl
         _sample(kin, path, (i - 1) / n, i / n, knots[-1], name, s_knots, knots, 0)
     knots_arr, s_arr = np.array(knots), np.array(s_knots)
     cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots_arr, kin.limits, speed, s_arr))
-    return Trajectory(kind, name, knots_arr, Profile(cruise, speed.ramp), path, length, s_arr)
+    return Trajectory(kind, name, knots_arr, _profile(cruise, speed, length), path, length, s_arr)
+
+
+def _profile(cruise: float, speed: Speed, tcp_per_s: float) -> Profile:
+    """The timing: `cruise` and the speed's ramp, both lengthened so that the half-cosine ramps keep the TCP within
+    MAX_TCP_ACCELERATION (their peak acceleration is pi/2 x peak speed / ramp). `tcp_per_s`: the TCP's fastest
+    travel per unit of the path parameter (its peak speed is that / cruise); a ramp longer than the cruise
+    stretches the cruise too."""
+    if cruise <= 0 or tcp_per_s <= 0:
+        return Profile(cruise, speed.ramp)
+    need = math.pi / 2 * tcp_per_s / MAX_TCP_ACCELERATION  # ramp x cruise needed
+    ramp = max(speed.ramp, need / cruise)
+    if ramp > cruise:  # a short, fast move: ramp up and straight down again, each as long as it must be
+        ramp = cruise = max(math.sqrt(need), min(speed.ramp, cruise))
+    return Profile(cruise, ramp)
 
 
 def _solve_at(kin: ArmKinematics, path: Callable[[float], Pose], s: float, seed: np.ndarray, name: str) -> np.ndarray:
@@ -231,7 +249,8 @@ def movej(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose | None
     angle = sum(a.angle(b) for a, b in zip(poses, poses[1:]))
     knots = np.array([q0, q1])
     cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots, kin.limits, speed))
-    return Trajectory("MoveJ", name, knots, Profile(cruise, speed.ramp), None, length)
+    fastest = max((a.distance(b) for a, b in zip(poses, poses[1:])), default=0.0) * steps
+    return Trajectory("MoveJ", name, knots, _profile(cruise, speed, fastest), None, length)
 
 
 def moveabsj(q_start: Iterable[float], q_target: Iterable[float], speed: Speed = Speed(),

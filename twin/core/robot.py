@@ -53,6 +53,8 @@ class Robot:
         self._t0: float | None = 0.0
         self._end_tcp: Pose | None = None
         self._settled = True
+        self._held = None
+        self._motors = client.setJointMotorControlArray  # bound once: called at every physics substep
         self._hold = self.q
         self._paused: np.ndarray | None = None  # while paused: where the arm holds
 
@@ -170,20 +172,27 @@ class Robot:
             self._command(self._paused, np.zeros(len(self.joints)))
             return
         if traj is None:
-            self._command(self._hold, np.zeros(len(self.joints)))
+            self._command_hold(self._hold)
             return
         if self._t0 is None:
             self._t0 = float(t)
         tau = t - self._t0 + self.dt
         if tau >= traj.duration:
             self._hold = traj.q_end
-            self._command(self._hold, np.zeros(len(self.joints)))
+            self._command_hold(self._hold)
         else:
             self._command(traj.q(tau), traj.qd(tau))
 
+    def _command_hold(self, q: np.ndarray) -> None:
+        """Hold q: commanded once (the motors keep their command), not again at every substep."""
+        if self._held is not q:
+            self._command(q, np.zeros(len(self.joints)))
+            self._held = q
+
     def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
         n = len(self.joints)
-        self.client.setJointMotorControlArray(self.body, self.joints, pybullet.POSITION_CONTROL,
+        self._held = None
+        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL,
                                               targetPositions=[float(v) for v in q],
                                               targetVelocities=[float(v) for v in qd],
                                               forces=self.forces, positionGains=[self.position_gain] * n,

@@ -20,6 +20,8 @@ from .mechanism import MOVABLE, FingerNameError, Mechanism, load_mechanism, read
 SHAPES = ("ring", "box", "cylinder", "plane")
 MAX_RING_SEGMENTS = 16
 IO_TYPES = ("DI", "DO", "AI", "AO", "GI", "GO")
+GRIP_MODES = ("friction", "attach")
+PYBULLET_DATA = "pybullet_data:"  # a path naming a model shipped with pybullet: pybullet_data:NAME.urdf
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,7 @@ class Body:
 class JointOverride:
     velocity: float | None = None
     effort: float | None = None
+    stiffness: float | None = None  # N/m or N*m/rad: the drive's position-loop stiffness
 
 
 @dataclass(frozen=True)
@@ -84,9 +87,13 @@ class GripperSpec:
     always_active: bool = False
     fingers: tuple[str, ...] | None = None
     joints: dict[str, JointOverride] = field(default_factory=dict)
-    contact_distance: float = 0.0005  # m: a finger touches a target within this gap
+    contact_distance: float = 0.0  # m: a finger touches a target within this gap (0: only when they touch)
     friction: float = 0.8
     initial: dict[str, float] = field(default_factory=dict)  # initial setpoints by input name
+    grip: str = "friction"  # "friction": held by contact friction alone; "attach": fixed while pressed
+    grip_force: float | None = None  # N (N*m): doGripped's per-finger threshold; None: 10 % of the finger's effort
+    attach_force: float | None = None  # N (N*m): attach mode's threshold; None: grip_force
+    slip_distance: float = 0.005  # m: a gripped part moved this far relative to the base link has slipped
 
 
 @dataclass(frozen=True)
@@ -236,6 +243,13 @@ class _Reader:
 
     def path_to(self, name: str) -> Path:
         text = self.get(name, str)
+        if text.startswith(PYBULLET_DATA):
+            import pybullet_data
+
+            path = (Path(pybullet_data.getDataPath()) / text[len(PYBULLET_DATA):]).resolve()
+            if not path.is_file():
+                raise self.error(name, f"pybullet ships no {text[len(PYBULLET_DATA):]!r} (looked at {path})")
+            return path
         path = (self.file.parent / text).resolve()
         if not path.exists():
             raise self.error(name, f"file {text!r} not found (looked at {path})")
@@ -324,7 +338,8 @@ def load_station(path: str | Path) -> Station:
     if jt is not None:
         for jname in list(jt.table):
             jr = jt.sub(jname)
-            joints[jname] = JointOverride(jr.number("velocity", None, positive=True), jr.number("effort", None, positive=True))
+            joints[jname] = JointOverride(jr.number("velocity", None, positive=True), jr.number("effort", None, positive=True),
+                                          jr.number("stiffness", None, positive=True))
             jr.done()
         jt.done()
     fingers = g.get("fingers", list, None)
@@ -343,9 +358,14 @@ def load_station(path: str | Path) -> Station:
         always_active=g.get("always_active", bool, False),
         fingers=tuple(fingers) if fingers is not None else None,
         joints=joints,
-        contact_distance=g.number("contact_distance", 0.0005, positive=True),
+        contact_distance=g.number("contact_distance", 0.0, nonnegative=True),
         friction=g.number("friction", 0.8, nonnegative=True),
         initial=initial,
+        grip=g.get("grip", str, "friction", check=lambda v: None if v in GRIP_MODES else
+                   f"must be one of {', '.join(repr(m) for m in GRIP_MODES)}, not {v!r}"),
+        grip_force=g.number("grip_force", None, positive=True),
+        attach_force=g.number("attach_force", None, positive=True),
+        slip_distance=g.number("slip_distance", 0.005, positive=True),
     )
     g.done()
 

@@ -16,7 +16,7 @@ from typing import Protocol
 from .errors import MotionError, SignalError, StationError
 from .gripper import IN_POSITION_TOLERANCE, MOVING_SPEED, Gripper
 from .mechanism import Mechanism, load_mechanism
-from .signals import BOOL, ENUM, FLOAT, INPUT, OUTPUT, SignalSpec
+from .signals import BOOL, ENUM, FLOAT, INPUT, INT, OUTPUT, SignalSpec
 from .station import Station, load_station
 from .world import ROBOT_PREFIX, World, quat
 
@@ -82,7 +82,8 @@ class Twin:
         self.world = World(st, self.mechanism.base_link)
         self.step_count = 0
         self.gripper = Gripper(self.world.client, self.world.machine, self.world.joint_index, self.world.link_index,
-                               self.mechanism, st.gripper, {t.name: self.world.body_ids[t.name] for t in st.targets})
+                               self.mechanism, st.gripper, {t.name: self.world.body_ids[t.name] for t in st.targets},
+                               self.world.substep)
         self.robot = None
         if st.robot is not None:
             from .geometry import Pose
@@ -102,6 +103,7 @@ class Twin:
             self.robot = Robot(self.world.client, self.world.machine,
                                tuple(ROBOT_PREFIX + j for j in st.robot.joints), self.kinematics)
             self.robot.reset([math.radians(a) for a in st.robot.home_deg])
+        self.world.check_overlaps()
         self._present = {f"{t.name}.present": True for t in st.targets}  # as written
         self._placed = dict(self._present)  # as applied to the world
         self._target_of = {f"{t.name}.present": t for t in st.targets}
@@ -134,10 +136,15 @@ class Twin:
             for device in self.devices:
                 device.before_step(self)
             self._place_targets()
-            self.gripper.command()
-            if self.robot is not None:
-                self.robot.update(self.time)
-            self.world.step()
+            # the drives and the arm are commanded at every physics substep: an arm command held for a whole
+            # step moves the flange in bursts that shake a friction grip loose (measured-facts.md)
+            t, h, gripper, robot, world = self.time, self.world.substep, self.gripper, self.robot, self.world
+            for k in range(world.substeps):
+                gripper.drive(k)
+                if robot is not None:
+                    robot.update(t + k * h)
+                world.substep_physics()
+                gripper.measure()
             self.step_count += 1
             self.gripper.sense()
             self._publish()
@@ -153,21 +160,32 @@ class Twin:
         for inp in m.inputs:
             sig.append(SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max,
                                   f"setpoint of {inp.type} joint {inp.joint}" + (f" ({inp.note})" if inp.note else "")))
-        sig.append(SignalSpec("doGripped", OUTPUT, BOOL, description="every finger touches the same target: it is held"))
+        sig.append(SignalSpec("doGripped", OUTPUT, BOOL, description="every finger presses on the same target with at least "
+                              "its grip force" + (f" ({st.gripper.grip_force:g})" if st.gripper.grip_force else "")))
         sig.append(SignalSpec("GrippedPart", OUTPUT, ENUM, description="the held target (none, or one of the target group)",
                               choices=("",) + targets))
+        sig.append(SignalSpec("slip", OUTPUT, BOOL, description=f"the gripped part moved more than "
+                              f"{st.gripper.slip_distance * 1000:g} mm relative to the gripper's base since it was "
+                              "gripped (held until the next grip)"))
         for inp in m.inputs:
             sig.append(SignalSpec(f"{inp.name}.actual", OUTPUT, FLOAT, inp.unit, inp.min, inp.max,
                                   f"actual position of joint {inp.joint}"))
             sig.append(SignalSpec(f"{inp.name}.in_position", OUTPUT, BOOL,
                                   description=f"{inp.name} is within {IN_POSITION_TOLERANCE[inp.unit]:g} {inp.unit} of its setpoint"))
             sig.append(SignalSpec(f"{inp.name}.moving", OUTPUT, BOOL, description=f"{inp.name} is moving"))
+            limit = self._effort_limit(inp)
+            sig.append(SignalSpec(f"{inp.name}.effort", OUTPUT, FLOAT, FORCE_UNIT[inp.unit], -limit, limit,
+                                  f"force of {inp.name}'s drive, signed along the joint (measured)"))
         for f in m.fingers:
             unit = FORCE_UNIT["m" if self._joint_unit(f.joint) == "m" else "rad"]
-            sig.append(SignalSpec(f"{f.name}.contact", OUTPUT, BOOL,
-                                  description=f"finger {f.name} touches a target (within {st.gripper.contact_distance * 1000:g} mm)"))
+            touch = "touches" if st.gripper.grip == "attach" else "touches and presses on"
+            sig.append(SignalSpec(f"{f.name}.contact", OUTPUT, BOOL, description=f"finger {f.name} {touch} a target"))
             sig.append(SignalSpec(f"{f.name}.force", OUTPUT, FLOAT, unit, 0.0, None,
-                                  f"force of finger {f.name}'s servo (magnitude)"))
+                                  f"normal force of finger {f.name} on target objects (measured"
+                                  + (", as torque about its joint)" if unit == "N*m" else ")")))
+            sig.append(SignalSpec(f"{f.name}.status", OUTPUT, INT, "", 0, 3,
+                                  f"finger {f.name}'s object status: 0 moving, 1 stopped by contact while opening, "
+                                  "2 stopped by contact while closing, 3 at the setpoint"))
         if st.robot is not None:
             sig.append(SignalSpec("robot.busy", OUTPUT, BOOL, group="robot", description="the robot is executing a motion"))
             for i, _ in enumerate(st.robot.joints, start=1):
@@ -186,6 +204,12 @@ class Twin:
                                    f"({seen[spec.name].description}; {spec.description}): rename a link or target")
             seen[spec.name] = spec
         return tuple(sig)
+
+    def _effort_limit(self, inp) -> float:
+        from .gripper import DEFAULT_EFFORT
+
+        o = self.station.gripper.joints.get(inp.name)
+        return (o.effort if o and o.effort else None) or inp.effort or DEFAULT_EFFORT[inp.unit]
 
     def _joint_unit(self, joint: str) -> str:
         for inp in self.mechanism.inputs:
@@ -257,14 +281,17 @@ class Twin:
         g, out = self.gripper.state, {}
         out["doGripped"] = bool(g.gripped)
         out["GrippedPart"] = g.gripped
+        out["slip"] = g.slip
         for inp in self.mechanism.inputs:
             axis = g.axes[inp.name]
             out[f"{inp.name}.actual"] = axis.actual
             out[f"{inp.name}.in_position"] = abs(axis.actual - self.gripper.setpoint[inp.name]) <= IN_POSITION_TOLERANCE[inp.unit]
             out[f"{inp.name}.moving"] = abs(axis.velocity) > MOVING_SPEED[inp.unit]
+            out[f"{inp.name}.effort"] = axis.effort
         for name, finger in g.fingers.items():
             out[f"{name}.contact"] = bool(finger.contacts)
             out[f"{name}.force"] = finger.force
+            out[f"{name}.status"] = finger.status
         if self.robot is not None:
             out["robot.busy"] = self.robot.busy(self.time)
             for i, q in enumerate(self.robot.q, start=1):
@@ -382,8 +409,7 @@ class Twin:
             body = self._target_of[key]
             uid, c = self.world.body_ids[body.name], self.world.client
             if not want:
-                if self.gripper.state.gripped == body.name:
-                    self.gripper._release()
+                self.gripper.forget(body.name)
                 c.resetBasePositionAndOrientation(uid, [0, 0, -100], [0, 0, 0, 1])
                 c.changeDynamics(uid, -1, mass=0)
             else:

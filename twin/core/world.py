@@ -28,6 +28,13 @@ from .station import Body, Placement, Station
 from ..native_output import quiet_native_output
 
 ROBOT_PREFIX = "robot/"
+COLLISION_MARGIN = 0.0001  # m: pybullet's default 1 mm margin rounds box corners (contact 0.4-0.7 mm late)
+CYLINDER_MARGIN = 0.001  # m: pybullet's own, kept for cylinders (rims round by 0.41 mm; sides are exact)
+OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
+
+
+def _mm(xyz) -> str:
+    return "(" + ", ".join(f"{v * 1000:.0f}" for v in xyz) + ")"
 
 
 def quat(p: Placement) -> tuple[float, float, float, float]:
@@ -143,10 +150,13 @@ class World:
 
     def __init__(self, station: Station, gripper_root: str):
         self.station = station
+        self.substeps = station.substeps
+        self.substep = station.step / station.substeps  # s: one physics step
         self._tmp = tempfile.TemporaryDirectory(prefix="gripper-twin-")
         with quiet_native_output():  # pybullet's argv[0] lines would corrupt `--json` output
             self.client = BulletClient(connection_mode=pybullet.DIRECT)
             self._build(station, gripper_root)
+        self._step_simulation = self.client.stepSimulation  # bound once: the client looks it up on every call
 
     def _build(self, station: Station, gripper_root: str) -> None:
         self.body_ids: dict[str, int] = {}
@@ -171,6 +181,7 @@ class World:
             info = self.client.getJointInfo(self.machine, j)
             self.joint_index[info[1].decode()] = j
             self.link_index[info[12].decode()] = j
+        self.link_name = {j: name for name, j in self.link_index.items()}
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
 
@@ -178,7 +189,10 @@ class World:
         c, st = self.client, self.station
         c.resetSimulation()
         c.setGravity(*st.gravity)
-        c.setPhysicsEngineParameter(fixedTimeStep=st.step, numSubSteps=st.substeps, numSolverIterations=50,
+        # substeps by hand: pybullet's numSubSteps applies a motor's limit in every substep with the whole step's
+        # impulse and reports only the last substep's contact impulse (measured-facts.md); one stepSimulation per
+        # substep keeps both true, and lets the robot and the drives be commanded at every substep
+        c.setPhysicsEngineParameter(fixedTimeStep=self.substep, numSubSteps=1, numSolverIterations=50,
                                     deterministicOverlappingPairs=1)
 
     def _create_body(self, body: Body) -> int:
@@ -209,10 +223,40 @@ class World:
         uid = c.createMultiBody(baseMass=body.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
                                 basePosition=body.pose.xyz, baseOrientation=quat(body.pose))
         c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
+        if body.shape in ("box", "ring"):  # sharp corners; a cylinder keeps pybullet's margin (a thin one makes a
+            c.changeDynamics(uid, -1, collisionMargin=COLLISION_MARGIN)  # squeezed one creep; its rims err 0.4 mm)
         return uid
 
-    def step(self) -> None:
-        self.client.stepSimulation()
+    def substep_physics(self) -> None:
+        """One physics substep (a simulation step is `substeps` of them)."""
+        self._step_simulation()
+
+    def check_overlaps(self, tolerance: float = OVERLAP_TOLERANCE) -> None:
+        """StationError when a target starts inside the gripper, the arm, a fixture or another target: physics
+        would shove it away (and fingers embedded in a part would grip it from step 0). Names both bodies."""
+        c, st = self.client, self.station
+        names = {uid: name for name, uid in self.body_ids.items()}
+        done: set[frozenset] = set()
+        for i, target in enumerate(st.targets):
+            uid = self.body_ids[target.name]
+            for other in [self.machine, *self.body_ids.values()]:
+                if other == uid or frozenset((uid, other)) in done:
+                    continue
+                done.add(frozenset((uid, other)))
+                points = c.getClosestPoints(uid, other, 0.0)
+                deepest = min(points, key=lambda pt: pt[8], default=None)
+                if deepest is None or deepest[8] >= -tolerance:
+                    continue
+                if other == self.machine:
+                    link = self.link_name.get(deepest[4], "base")
+                    what = (f"the robot's link {link[len(ROBOT_PREFIX):]!r}" if link.startswith(ROBOT_PREFIX)
+                            else f"the gripper's link {link!r}")
+                else:
+                    kind = "target" if any(t.name == names[other] for t in st.targets) else "fixture"
+                    what = f"{kind} {names[other]!r}"
+                raise StationError(str(st.file), f"targets[{i}]", f"target {target.name!r} overlaps {what} by "
+                                   f"{-deepest[8] * 1000:.1f} mm at the start (at {_mm(deepest[5])} mm): "
+                                   "move the target, the robot's home or the gripper's initial setpoints")
 
     def pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """A target's or fixture's frame (built here with no inertial offset, so its centre of mass is its frame)."""
