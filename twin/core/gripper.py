@@ -103,7 +103,8 @@ class Gripper:
     """Servoes the gripper's joints, measures forces and contacts, and decides grip, slip and release."""
 
     def __init__(self, client, body: int, joint_index: dict[str, int], link_index: dict[str, int],
-                 mechanism: Mechanism, spec: GripperSpec, targets: dict[str, int], substep: float):
+                 mechanism: Mechanism, spec: GripperSpec, targets: dict[str, int], substep: float,
+                 contact_probe=None):
         self.client, self.body, self.mechanism, self.spec = client, body, mechanism, spec
         self.targets = targets  # target name -> body id, in station order
         self._target_by_id = {uid: name for name, uid in targets.items()}
@@ -124,6 +125,8 @@ class Gripper:
         self.mimics = [(joint_index[m.joint], master_input[m.master], m.multiplier, m.offset) for m in mechanism.mimics]
         self.finger_links = {f.name: [link_index[n] for n in f.links] for f in mechanism.fingers}
         self._finger_of_link = {link: f for f, links in self.finger_links.items() for link in links}
+        # exact shapes for the contact flag (contact.py); links it cannot copy are asked of the physics world
+        self.probe = contact_probe(self.finger_links, targets) if contact_probe is not None else None
         self.finger_joint = {f.name: joint_index[f.joint] for f in mechanism.fingers}
         servo_of = {j: name for name, j in self.joint.items()} | {j: master for j, master, _, _ in self.mimics}
         # the servos (inputs) that drive each finger, nearest first: its own joint's (or its master's), then those
@@ -404,9 +407,15 @@ class Gripper:
             lo, hi = c.getAABB(self.body, link)
             nearby = c.getOverlappingObjects([v - d - COLLISION_MARGIN for v in lo], [v + d + COLLISION_MARGIN for v in hi]) or ()
             limit = d - (COLLISION_MARGIN if link in self._mesh_links else 0.0)
-            for uid in {uid for uid, _ in nearby if uid in self._target_by_id}:
-                points = c.getClosestPoints(self.body, uid, d + COLLISION_MARGIN, linkIndexA=link)
-                if any(pt[8] <= limit for pt in points):
+            exact = self.probe is not None and self.probe.covers(link)
+            for uid in sorted({uid for uid, _ in nearby if uid in self._target_by_id}):
+                if exact:
+                    gap = self.probe.distance(link, uid, d)
+                    touching = gap is not None and gap <= d
+                else:
+                    touching = any(pt[8] <= limit for pt in c.getClosestPoints(self.body, uid, d + COLLISION_MARGIN,
+                                                                               linkIndexA=link))
+                if touching:
                     found.add(self._target_by_id[uid])
         return tuple(name for name in self.targets if name in found)
 

@@ -145,6 +145,39 @@ def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper_urdf: P
     return out
 
 
+def create_body(c, body: Body) -> int:
+    """Build a target or fixture as a pybullet body in client `c`."""
+    color = list(body.color)
+    if body.shape == "plane":
+        col = c.createCollisionShape(pybullet.GEOM_PLANE)
+        vis = c.createVisualShape(pybullet.GEOM_PLANE, rgbaColor=color)
+    elif body.shape == "box":
+        half = [s / 2 for s in body.size]
+        col = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
+        vis = c.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=color)
+    elif body.shape == "cylinder":
+        col = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=body.radius, height=body.height)
+        vis = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=body.radius, length=body.height, rgbaColor=color)
+    else:  # ring: a compound of boxes; the outside is a regular polygon whose apothem is the outer radius
+        n = body.segments
+        r_out, r_in = body.outer_diameter / 2, body.inner_diameter / 2
+        width = 2 * r_out * math.tan(math.pi / n)
+        half = [(r_out - r_in) / 2, width / 2, body.height / 2]
+        angles = [2 * math.pi * k / n for k in range(n)]
+        positions = [[(r_in + r_out) / 2 * math.cos(a), (r_in + r_out) / 2 * math.sin(a), 0.0] for a in angles]
+        orns = [list(pybullet.getQuaternionFromEuler([0, 0, a])) for a in angles]
+        col = c.createCollisionShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
+                                          collisionFramePositions=positions, collisionFrameOrientations=orns)
+        vis = c.createVisualShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
+                                       visualFramePositions=positions, visualFrameOrientations=orns)
+    uid = c.createMultiBody(baseMass=body.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
+                            basePosition=body.pose.xyz, baseOrientation=quat(body.pose))
+    c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
+    if body.shape in ("box", "ring"):  # sharp corners; a cylinder keeps pybullet's margin (a thin one makes a
+        c.changeDynamics(uid, -1, collisionMargin=COLLISION_MARGIN)  # squeezed one creep; its rims err 0.4 mm)
+    return uid
+
+
 class World:
     """A pybullet world built from a station. Owns the connection; `close()` releases it."""
 
@@ -196,36 +229,16 @@ class World:
                                     deterministicOverlappingPairs=1)
 
     def _create_body(self, body: Body) -> int:
-        c = self.client
-        color = list(body.color)
-        if body.shape == "plane":
-            col = c.createCollisionShape(pybullet.GEOM_PLANE)
-            vis = c.createVisualShape(pybullet.GEOM_PLANE, rgbaColor=color)
-        elif body.shape == "box":
-            half = [s / 2 for s in body.size]
-            col = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
-            vis = c.createVisualShape(pybullet.GEOM_BOX, halfExtents=half, rgbaColor=color)
-        elif body.shape == "cylinder":
-            col = c.createCollisionShape(pybullet.GEOM_CYLINDER, radius=body.radius, height=body.height)
-            vis = c.createVisualShape(pybullet.GEOM_CYLINDER, radius=body.radius, length=body.height, rgbaColor=color)
-        else:  # ring: a compound of boxes; the outside is a regular polygon whose apothem is the outer radius
-            n = body.segments
-            r_out, r_in = body.outer_diameter / 2, body.inner_diameter / 2
-            width = 2 * r_out * math.tan(math.pi / n)
-            half = [(r_out - r_in) / 2, width / 2, body.height / 2]
-            angles = [2 * math.pi * k / n for k in range(n)]
-            positions = [[(r_in + r_out) / 2 * math.cos(a), (r_in + r_out) / 2 * math.sin(a), 0.0] for a in angles]
-            orns = [list(pybullet.getQuaternionFromEuler([0, 0, a])) for a in angles]
-            col = c.createCollisionShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
-                                              collisionFramePositions=positions, collisionFrameOrientations=orns)
-            vis = c.createVisualShapeArray([pybullet.GEOM_BOX] * n, halfExtents=[half] * n,
-                                           visualFramePositions=positions, visualFrameOrientations=orns)
-        uid = c.createMultiBody(baseMass=body.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
-                                basePosition=body.pose.xyz, baseOrientation=quat(body.pose))
-        c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
-        if body.shape in ("box", "ring"):  # sharp corners; a cylinder keeps pybullet's margin (a thin one makes a
-            c.changeDynamics(uid, -1, collisionMargin=COLLISION_MARGIN)  # squeezed one creep; its rims err 0.4 mm)
-        return uid
+        return create_body(self.client, body)
+
+    def contact_probe(self, finger_links: dict[str, list[int]], targets: dict[str, int]):
+        """The exact-contact probe for these finger links and targets (closed with the world)."""
+        from .contact import ContactProbe
+
+        spec = {t.name: t for t in self.station.targets}
+        self.probe = ContactProbe(self.client, self.machine, finger_links, targets,
+                                  lambda client, name: create_body(client, spec[name]))
+        return self.probe
 
     def substep_physics(self) -> None:
         """One physics substep (a simulation step is `substeps` of them)."""
@@ -264,6 +277,9 @@ class World:
         return tuple(pos), tuple(orn)
 
     def close(self) -> None:
+        if getattr(self, "probe", None) is not None:
+            self.probe.close()
+            self.probe = None
         try:
             self.client.disconnect()
         except pybullet.error:
