@@ -18,7 +18,7 @@ the link: `plc_client.link.LinkFaults`.
 |---|---|---|
 | `PartMissing` | the part is taken out of the cell (`TARGET.present` = 0), put back when it ends | no contact; a grip closes to the end of travel |
 | `PartDisplaced` | the part is moved by an offset (and turned about z), at rest | `TARGET.x/y/z` jump |
-| `FingerJammed` | a hard stop at `position`: the joint gets there and no further, then stays stuck there | `NAME.actual` stops; its servo force builds as against a part |
+| `FingerJammed` | a hard stop at `position`: the joint gets there and no further, then stays stuck there | `NAME.actual` stops; its drive's effort builds as against a part (its `NAME.force`, on no part, stays 0) |
 | `DriveForceLost` | the joint's drive pushes with at most `effort` (N or N*m) | the finger's force stays at or below it; no grip force |
 | `ReadingStuck` | nothing | an output keeps one value (its value when the fault starts, or `value`) |
 | `ReadingOffset` | nothing | an output reads `offset` more than it is |
@@ -145,6 +145,7 @@ class FingerJammed(Fault):
         body, joint, inp = self._joint(twin)
         actual = twin.world.client.getJointState(body, joint)[0]
         self._at = actual if self.position is None else float(self.position)
+        self._side = 1.0 if actual >= self._at else -1.0  # which side of the stop the joint comes from
         self._stuck = False
         self._limit(twin, actual)
 
@@ -156,10 +157,10 @@ class FingerJammed(Fault):
     def _limit(self, twin, actual: float) -> None:
         body, joint, inp = self._joint(twin)
         p = self._at
-        if abs(actual - p) <= JAM_REACHED[inp.unit]:
+        if (actual - p) * self._side <= JAM_REACHED[inp.unit]:  # there, or a hair past it within a step
             lo = hi = p
             self._stuck = True
-        elif actual > p:
+        elif self._side > 0:
             lo, hi = p, inp.max  # the stop is below: it may move up, and down as far as the stop
         else:
             lo, hi = inp.min, p

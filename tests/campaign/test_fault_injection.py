@@ -72,7 +72,8 @@ def test_a_jammed_finger_stops_at_its_position_and_presses_on(bench):
     assert bench.read("L2.actual") == pytest.approx(0.326, abs=0.0005)
     assert not bench.read("L2.contact")
     _, effort = bench.drive_limits("L2")
-    assert bench.read("L2.force") == pytest.approx(effort, rel=0.05)
+    assert -bench.read("L2.effort") == pytest.approx(effort, rel=0.05)  # the drive presses on the stop...
+    assert bench.read("L2.force") == 0.0  # ...but on no part: the measured finger force stays 0
     bench.write("L2", 0.34)  # stuck: it does not open either
     bench.step(60)
     assert bench.read("L2.actual") == pytest.approx(0.326, abs=0.0005)

@@ -17,9 +17,9 @@ def test_a_served_twin_meets_the_faults_of_its_faults_file(tmp_path):
     with twin_server(BENCH, faults=faults) as server, server.client() as plc:
         plc.write(L2=300.0)  # only finger 1 closes: it jams 6 mm before the ring
         plc.advance(150)
-        values = plc.read("L2.actual", "L2.contact", "L2.force", "L3.actual", "L3.force")
+        values = plc.read("L2.actual", "L2.contact", "L2.force", "L2.effort", "L3.actual", "L3.force")
     assert values["L2.actual"] == pytest.approx(326.0, abs=0.5) and not values["L2.contact"]  # jammed short
-    assert values["L2.force"] > 1000.0  # pressing on the jam
+    assert values["L2.effort"] < -1000.0 and values["L2.force"] == 0.0  # its drive presses on the jam, on no part
     assert values["L3.actual"] == pytest.approx(330.0, abs=0.5)  # finger 2 stands free ...
     assert values["L3.force"] == pytest.approx(50.0, abs=1.0)  # ... and reads 50 N too much
 

@@ -7,8 +7,8 @@ import struct
 from modbus_helpers import pdu
 
 IMAGE_IN, IMAGE_OUT = 0x8000, 0xC000
-# the ring bench's table sizes (from `twin map`): coils 18, discrete inputs 29, holding 20, input registers 33
-DI_WORDS, IR, COIL_WORDS, HR, COILS = 2, 33, 2, 20, 18
+# the ring bench's table sizes (from `twin map`): coils 18, discrete inputs 29, holding 20, input registers 44
+DI_WORDS, IR, COIL_WORDS, HR, COILS = 2, 44, 2, 20, 18
 L2 = 16
 
 

@@ -56,14 +56,14 @@ def test_the_same_logic_over_modbus_moves_the_process_as_in_process(server):
         c.write(L2=330.0, L3=330.0, L4=330.0)
         start = c.get("sim.step")
         plc = ScanCycle(ClientIO(c), logic, cycle=0.012)
-        plc.run(scans=60)
+        plc.run(scans=90)
         remote = c.read("L2.actual", "L3.actual", "L2.force", "doGripped")
         steps = c.get("sim.step") - start
     with Twin.from_station(BENCH) as twin:
         twin.write("L2", 0.33), twin.write("L3", 0.33), twin.write("L4", 0.33)
         twin.step(start)
         local = ScanCycle(TwinIO(twin), logic, cycle=0.012)
-        local.run(scans=60)
+        local.run(scans=90)
         assert twin.step_count - start == steps
         assert remote["doGripped"] == twin.read("doGripped")
         assert remote["L2.actual"] == pytest.approx(twin.read("L2.actual") * 1000, abs=0.011)

@@ -26,6 +26,9 @@ class ContactProbe:
         self.physics, self.body = physics, body
         with quiet_native_output():
             self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        from .world import bind_calls
+
+        bind_calls(self.client)
         c = self.client
         self.links: dict[int, tuple[int, float]] = {}  # physics link -> (probe body, distance correction)
         for links in finger_links.values():

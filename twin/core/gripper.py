@@ -311,7 +311,10 @@ class Gripper:
                 # for, so a held-back drive asks for far more; its force limit is then what it presses with
                 speed = BLOCKED_SPEEDUP * d.velocity * (1.0 if error > 0 else -1.0)
             velocities.append(speed)
-            forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
+            if joint_speed * speed > 0 and abs(joint_speed) > abs(speed):
+                forces.append(d.effort)  # running on past where the loop wants it: brake with all it has (no overshoot)
+            else:
+                forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
             quiet = (quiet and before == goal[name] and abs(joint_speed) < MOVING_SPEED[self.unit[name]]
                      and abs(error) < BLOCKED_SHARE * full)  # a drive pressing on a part is followed every substep
         self._quiet = quiet
@@ -362,8 +365,9 @@ class Gripper:
         friction = self.spec.grip == "friction"
         fingers = {}
         for finger in self.finger_links:
-            touching = self._touching(finger, CONTACT_SLACK if friction else 0.0)
             on = {t: pressing[finger].get(t, 0.0) for t in self.targets if pressing[finger].get(t, 0.0) > 0.0}
+            # friction mode: no contact without a normal force, so a finger pressing on nothing needs no query
+            touching = self._touching(finger, CONTACT_SLACK) if on else () if friction else self._touching(finger)
             contacts = tuple(t for t in touching if not friction or t in on)
             force = sum(on.values())
             fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
@@ -430,8 +434,10 @@ class Gripper:
         if abs(goal - axis.actual) <= IN_POSITION_TOLERANCE[unit]:
             return STATUS_AT_SETPOINT
         d = self.drives[name]
-        blocked = abs(axis.velocity) <= MOVING_SPEED[unit] and (
-            contact or abs(self.command_position[name] - axis.actual) >= 0.5 * d.full_error)
+        # stopped by contact: it stands although its drive pushes with at least half its force limit (a finger
+        # that merely starts to move away from a part it pressed on is not stopped by it)
+        blocked = (abs(axis.velocity) <= MOVING_SPEED[unit]
+                   and abs(self.command_position[name] - axis.actual) >= 0.5 * d.full_error)
         if not blocked:
             return STATUS_MOVING
         closing = (goal - axis.actual) * self.closing[name] > 0

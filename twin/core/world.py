@@ -13,6 +13,7 @@ planar, floating and spherical gripper joints made fixed, as the mechanism treat
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 import tempfile
@@ -178,6 +179,18 @@ def create_body(c, body: Body) -> int:
     return uid
 
 
+HOT_CALLS = ("stepSimulation", "getJointStates", "getJointState", "setJointMotorControlArray", "getContactPoints",
+             "getClosestPoints", "getAABB", "getOverlappingObjects", "getLinkState", "getBasePositionAndOrientation",
+             "resetBasePositionAndOrientation", "invertTransform", "multiplyTransforms", "getJointInfo")
+
+
+def bind_calls(client: BulletClient) -> None:
+    """Bind the calls made at every step to the client once: pybullet_utils' client looks each function up
+    anew (and inspects it) on every call, which costs as much as the call itself."""
+    for name in HOT_CALLS:
+        setattr(client, name, functools.partial(getattr(pybullet, name), physicsClientId=client._client))
+
+
 class World:
     """A pybullet world built from a station. Owns the connection; `close()` releases it."""
 
@@ -189,7 +202,8 @@ class World:
         with quiet_native_output():  # pybullet's argv[0] lines would corrupt `--json` output
             self.client = BulletClient(connection_mode=pybullet.DIRECT)
             self._build(station, gripper_root)
-        self._step_simulation = self.client.stepSimulation  # bound once: the client looks it up on every call
+        bind_calls(self.client)
+        self._step_simulation = self.client.stepSimulation
 
     def _build(self, station: Station, gripper_root: str) -> None:
         self.body_ids: dict[str, int] = {}
