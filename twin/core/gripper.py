@@ -311,10 +311,7 @@ class Gripper:
                 # for, so a held-back drive asks for far more; its force limit is then what it presses with
                 speed = BLOCKED_SPEEDUP * d.velocity * (1.0 if error > 0 else -1.0)
             velocities.append(speed)
-            if joint_speed * speed > 0 and abs(joint_speed) > abs(speed):
-                forces.append(d.effort)  # running on past where the loop wants it: brake with all it has (no overshoot)
-            else:
-                forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
+            forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
             quiet = (quiet and before == goal[name] and abs(joint_speed) < MOVING_SPEED[self.unit[name]]
                      and abs(error) < BLOCKED_SHARE * full)  # a drive pressing on a part is followed every substep
         self._quiet = quiet
