@@ -238,6 +238,7 @@ class FramePublisher:
         self.observer = observer or Observer(twin)
         self.scene = self.observer.scene
         self.latest: Frame = self.observer.frame()
+        self.stale = False  # a step ran since `latest` was taken
         self._wanted = False
         self.listeners: list = []  # called with each new frame, in the stepping thread
 
@@ -254,13 +255,21 @@ class FramePublisher:
         pass
 
     def after_step(self, twin) -> None:
+        self.stale = True
         if self._wanted or self.listeners:
             self._wanted = False
+            self.refresh()
+
+    def refresh_if_stale(self) -> None:
+        """Take a frame if a step ran since the last one (call it in the stepping thread, e.g. via the event
+        loop): after a burst of steps the last one is shown, not one from the middle of the burst."""
+        if self.stale:
             self.refresh()
 
     def refresh(self) -> Frame:
         frame = self.observer.frame()
         self.latest = frame
+        self.stale = False
         for listener in self.listeners:
             listener(frame)
         return frame

@@ -31,7 +31,6 @@ CONTACT, NO_CONTACT = (230, 30, 30), (120, 120, 120)
 FORCE_COLOUR = (250, 200, 0)
 GHOST_OPACITY = 0.3
 TABLE_HZ = 10.0  # the signal table's refresh rate (the 3D scene and the state line follow every frame)
-MIN_FORCE_SCALE = 0.0005  # m per N for the force arrows at least; more when the fingers are strong
 
 
 def engineering(signal: dict) -> tuple[str, float]:
@@ -143,12 +142,16 @@ class CellPage:
                 parts.append((link, frame))
             self._ghosts[f.name] = parts
         self._markers, self._arrows = {}, {}
+        finger_links = {link for f in scene.fingers for link in f.links}
+        sizes = [max(v.size) if v.shape != "mesh" else 0.1 for v in scene.visuals if v.body in finger_links and v.size]
+        self.arrow_length = 1.5 * max(sizes + [0.015])  # the strongest finger's force arrow: 1.5 finger lengths
+        a = self.arrow_length
         for f in scene.fingers:
-            self._markers[f.name] = sc.add_icosphere(f"/fingers/{_node(f.name)}/contact", radius=0.015, color=NO_CONTACT,
-                                                         cast_shadow=False, receive_shadow=False)
+            self._markers[f.name] = sc.add_icosphere(f"/fingers/{_node(f.name)}/contact", radius=0.06 * a,
+                                                     color=NO_CONTACT, cast_shadow=False, receive_shadow=False)
             self._arrows[f.name] = sc.add_arrows(f"/fingers/{_node(f.name)}/force", np.zeros((1, 2, 3), np.float32),
-                                                 FORCE_COLOUR, shaft_radius=0.006, head_radius=0.015, head_length=0.03,
-                                                 visible=False)
+                                                 FORCE_COLOUR, shaft_radius=0.02 * a, head_radius=0.05 * a,
+                                                 head_length=0.12 * a, visible=False)
         for name, pose in scene.robot_targets.items():
             sc.add_frame(f"/robot_targets/{_node(name)}", axes_length=0.08, axes_radius=0.004,
                          position=tuple(pose[:3]), wxyz=_wxyz(pose[3:7]))
@@ -333,8 +336,7 @@ class CellPage:
         setpoints = {s["name"]: values[s["name"]] for s in self.scene.signals
                      if s["direction"] == "input" and s["type"] == "float" and s["name"] in values}
         forces = [abs(float(values.get(f"{f.name}.force") or 0.0)) for f in self.scene.fingers]
-        scale = max(MIN_FORCE_SCALE, 0.25 / max(forces + [1.0]))  # the strongest finger's arrow: at most 0.25 m
-        scale = max(scale, MIN_FORCE_SCALE)
+        scale = self.arrow_length / max(forces + [1.0])  # the strongest finger's arrow is arrow_length long
         for f, force in zip(self.scene.fingers, forces):
             link, offset = self._finger_tips[f.name]
             if link not in self._body_index:

@@ -114,11 +114,18 @@ class PageProcess:
     def _link(self) -> None:
         next_t = time.perf_counter()
         last = None
+        steps_seen = -1
         try:
             while not self._stop.is_set():
                 while self.conn.poll(0):
                     self._handle(self.conn.recv())
                 if self.ready.is_set():
+                    count = self.publisher.observer.twin.step_count
+                    if self.publisher.stale and count == steps_seen:
+                        # no step since the last tick, but the frame is older than the last step (a burst
+                        # ended between two requests): take the last state, in the stepping thread
+                        self.controls.loop.call_soon_threadsafe(self.publisher.refresh_if_stale)
+                    steps_seen = count
                     self.publisher.request()
                     frame = self.publisher.latest
                     state, buttons = self.controls.state(), self.controls.buttons()
