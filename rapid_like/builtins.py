@@ -234,7 +234,7 @@ _INSTRUCTIONS = {
              "\\switch Corr, " + _MOVE_OPTS,
     "MoveAbsJ": "jointtarget ToJointPos, speeddata Speed, zonedata Zone, tooldata Tool, \\switch NoEOffs, "
                 + _MOVE_OPTS,
-    "Stop": r"\switch NoRegain",
+    "Stop": r"\switch NoRegain | switch AllMoveTasks",
     "Break": "",
     "ConfJ": r"\switch On, \switch Off",
     "ConfL": r"\switch On, \switch Off",
@@ -328,6 +328,19 @@ _INSTRUCTIONS = {
                  r"num DeltaValue, \switch DPos | switch DNeg, intnum Interrupt",
     "ISignalAO": r"\switch Single | switch SingleSafe, signalao Signal, num Condition, num HighValue, num LowValue, "
                  r"num DeltaValue, \switch DPos | switch DNeg, intnum Interrupt",
+    "TriggIO": r"INOUT triggdata TriggData, num Distance, \switch Start | switch Time, "
+               r"\signaldo DOp | signalgo GOp | signalao AOp | num ProcID, num SetValue, \num DODelay",
+    "TriggEquip": r"INOUT triggdata TriggData, num Distance, \switch Start, num EquipLag, "
+                  r"\signaldo DOp | signalgo GOp | signalao AOp | num ProcID, num SetValue, \INOUT bool Inhib",
+    "TriggInt": r"INOUT triggdata TriggData, num Distance, \switch Start | switch Time, intnum Interrupt",
+    "TriggL": r"\switch Conc, robtarget ToPoint, \num ID, speeddata Speed, \num T, triggdata Trigg1, "
+              r"\triggdata T2, \triggdata T3, \triggdata T4, \triggdata T5, \triggdata T6, \triggdata T7, "
+              r"\triggdata T8, zonedata Zone, \stoppointdata Inpos, tooldata Tool, \wobjdata WObj, "
+              r"\loaddata TLoad",
+    "TriggJ": r"\switch Conc, robtarget ToPoint, \num ID, speeddata Speed, \num T, triggdata Trigg1, "
+              r"\triggdata T2, \triggdata T3, \triggdata T4, \triggdata T5, \triggdata T6, \triggdata T7, "
+              r"\triggdata T8, zonedata Zone, \stoppointdata Inpos, tooldata Tool, \wobjdata WObj, "
+              r"\loaddata TLoad",
     "SpyStart": "string File",
     "SpyStop": "",
     "BookErrNo": "INOUT errnum ErrorName",
@@ -413,6 +426,8 @@ _FUNCTIONS = {
     "DefFrame": (r"robtarget OriginP1, robtarget OriginP2, robtarget OriginP3, \num Origin", "pose"),
     "CPos": (r"\tooldata Tool, \wobjdata WObj", "pos"),
     "CTool": ("", "tooldata"),
+    "CalcJointT": (r"\switch UseCurWObjPos, robtarget Rob_target, tooldata Tool, \wobjdata WObj", "jointtarget"),
+    "CalcRobT": (r"jointtarget Joint_target, tooldata Tool, \wobjdata WObj", "robtarget"),
     "CWObj": ("", "wobjdata"),
     "VectMagn": ("pos Vector", "num"),
     "DotProd": ("pos Vector1, pos Vector2", "num"),

@@ -56,6 +56,9 @@ _APPROXIMATE = {
     "searchl": "the search moves to ToPoint; it hits when the signal is 1 at the start or at the end of the "
                "motion (SearchPoint := ToPoint), else ERR_WHLSEARCH",
     "write": "written files go to the trace (type file), not to disk",
+    "triggio": "the output is set when the TriggL/TriggJ motion ends, not at its Distance on the path",
+    "triggequip": "the output is set when the TriggL/TriggJ motion ends, not at its Distance (EquipLag unused)",
+    "triggint": "the interrupt occurs when the TriggL/TriggJ motion ends, not at its Distance on the path",
     "spystart": "no spy log is written",
     "waitrob": "motions end in position, so WaitRob never waits",
 }
@@ -563,7 +566,8 @@ class Checker:
                 raise self.err(f"{s.name}: no PROC named {proc.value!r} to call at the point", proc.span)
             self.warn(s.span, f"{word}: the procedure runs when the robot is at the point (not in the middle "
                               f"of the corner path)")
-        if key in ("movej", "movel", "movec", "moveabsj", "movejdo", "moveldo", "movejsync", "movelsync"):
+        if key in ("movej", "movel", "movec", "moveabsj", "movejdo", "moveldo", "movejsync", "movelsync", "triggl",
+                   "triggj"):
             zone = next((a for a in s.args if a.value is not None and not a.optional and a.value.text.lower() in
                          B.zone_names()), None)
             if any(a.optional and a.key == "conc" for a in s.args):
@@ -760,6 +764,9 @@ class Checker:
         if key in B.FUNCTIONS:
             params, rtype = B.FUNCTIONS[key]
             self.args(e.name, params, e.args, e.span, scope)
+            if key in ("calcjointt", "calcrobt"):
+                self.warn(e.span, f"{B.PROPER_NAMES[key]}: there is no kinematics model here: it returns the robot's "
+                                  f"present {'joints' if key == 'calcjointt' else 'position'}")
             return rtype
         if key in B.INSTRUCTIONS:
             raise self.err(f"{e.name} is an instruction and returns no value", e.span)

@@ -314,6 +314,40 @@ class SystemMixin:
             raise self.fail(f"SearchL: {sig.name} did not change during the search", s.span, "ERR_WHLSEARCH")
         arg("searchpoint").set(arg("topoint"))
 
+    # ---- triggers: TriggIO/TriggEquip/TriggInt set up, TriggL/TriggJ move and fire them at the end --------
+    def _trigg(self, arg, entry) -> None:
+        ref = arg("triggdata")
+        dev = ref.get()
+        dev.state = [entry]  # a triggdata holds the last trigger defined with it
+
+    def i_triggio(self, s, arg, text, bound):
+        out = next((arg(k) for k in ("dop", "gop", "aop") if arg(k) is not None), None)
+        self._trigg(arg, ("io", out, arg("setvalue"), arg("distance")))
+        yield from ()
+
+    i_triggequip = i_triggio
+
+    def i_triggint(self, s, arg, text, bound):
+        no = self._intno(arg, bound)
+        self._trigg(arg, ("int", no, None, arg("distance")))
+        yield from ()
+
+    def _trigg_move(self, s, arg, text, bound, instr: str):
+        yield from self._move(s, arg, text, bound, instr)
+        for key in ("trigg1", "t2", "t3", "t4", "t5", "t6", "t7", "t8"):
+            data = arg(key)
+            for kind, target, value, _distance in (data.state or []) if data is not None else []:
+                if kind == "io" and target is not None:
+                    self.write(target, float(value) if target.kind != "DO" else (0.0 if value == 0 else 1.0))
+                elif kind == "int" and target in self.interrupts.traps:
+                    self.interrupts.pending.append(target)
+
+    def i_triggl(self, s, arg, text, bound):
+        yield from self._trigg_move(s, arg, text, bound, "MoveL")
+
+    def i_triggj(self, s, arg, text, bound):
+        yield from self._trigg_move(s, arg, text, bound, "MoveJ")
+
     # ---- files (iodev): written files go to the trace, read ones come from disk -----------------------
     def _path(self, arg) -> str:
         obj, name = arg("object"), arg("file")
@@ -606,6 +640,14 @@ class SystemMixin:
         z = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]
         o = p1 if origin != 2 else [a + along * xi for a, xi in zip(p1, x)]
         return _pose_record((o, _quat_from_axes(x, y, z)))
+
+    def f_calcjointt(self, e, arg, bound):
+        """CalcJointT without kinematics: the present joints (rapid check warns)."""
+        return self.host.current_jointtarget()
+
+    def f_calcrobt(self, e, arg, bound):
+        """CalcRobT without kinematics: the present TCP of the tool (rapid check warns)."""
+        return self.host.current_robtarget(arg("tool"), arg("wobj"))
 
     def f_cpos(self, e, arg, bound):
         return self.host.current_robtarget(arg("tool"), arg("wobj")).fields["trans"]
