@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import PYBULLET_DATA, STATIONS
-from tests.core.urdfs import station
+from tests.core.test_foreign_models import robot_station
 from twin.core import Twin
 from twin.observe import Observer, pose_matrix, setpoint_motion
 
@@ -37,7 +37,7 @@ def test_mesh_visuals_are_found_and_load(tmp_path):
     pytest.importorskip("trimesh")
     from twin.view.page import _load_mesh
 
-    path = station(tmp_path, PYBULLET_DATA / "franka_panda" / "panda.urdf")
+    path = robot_station(tmp_path, gripper=PYBULLET_DATA / "franka_panda" / "panda.urdf")  # under the arm
     with Twin.from_station(path) as twin:
         scene = Observer(twin).scene
     meshes = [v for v in scene.visuals if v.shape == "mesh"]
