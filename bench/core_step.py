@@ -46,9 +46,11 @@ def twin_vs_physics(station: Path, steps: int, rounds: int = 5) -> dict[str, flo
 def crowded_station(folder: Path, extra: int) -> Path:
     text = (STATIONS / "four_finger" / "station.toml").read_text()
     text = text.replace('urdf = "gripper4.urdf"', f'urdf = "{STATIONS / "four_finger" / "gripper4.urdf"}"')
-    side = max(1, int(extra ** 0.5) + 1)
+    side = max(1, int(extra ** 0.5) + 2)
+    spots = [(0.3 + 0.12 * (k % side), -0.5 + 0.12 * (k // side)) for k in range(side * side)]
+    spots = [(x, y) for x, y in spots if abs(x - 0.5) > 0.1 or abs(y) > 0.1]  # clear of the loose box
     for k in range(extra):
-        x, y = 0.3 + 0.12 * (k % side), -0.5 + 0.12 * (k // side)
+        x, y = spots[k]
         text += (f'\n[[targets]]\nname = "c{k}"\nshape = "cylinder"\nradius = 0.03\nheight = 0.04\n'
                  f'xyz = [{x:.3f}, {y:.3f}, 0.02]\ndensity = 1000.0\n')
     path = folder / f"crowded_{extra}.toml"

@@ -317,8 +317,11 @@ class Gripper:
         self._quiet = quiet
         self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities, forces=forces)
 
-    def measure(self) -> None:
-        """After a physics substep: add up the drives' applied forces and the fingers' contact forces."""
+    def measure(self, last: bool = True) -> None:
+        """After a physics substep: add up the drives' applied forces and the fingers' contact forces. While every
+        drive stands quiet, the step's last substep alone is read (nothing moves in between)."""
+        if self._quiet and not last:
+            return
         self._n += 1
         for i, s in enumerate(self._joint_states(self.body, self._joint_ids)):
             self._effort_sum[i] += s[3]

@@ -144,7 +144,7 @@ class Twin:
                 if robot is not None:
                     robot.update(t + k * h)
                 world.substep_physics()
-                gripper.measure()
+                gripper.measure(k == world.substeps - 1)
             self.step_count += 1
             self.gripper.sense()
             self._publish()
