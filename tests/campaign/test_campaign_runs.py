@@ -43,10 +43,6 @@ def test_small_campaign_passes_with_the_right_counts(bench_runs):
     for r in missing:
         assert (r["outcome"], r["fault"], r["grip"], r["plc_faults"]) == ("stopped", "missed", "missed", "missed")
         assert float(r["time"]) == pytest.approx(40.0 / 20.0, abs=0.1)
-    # a higher threshold takes longer to reach
-    by = {(r["ring.offset_x_mm"], r["plc.threshold"]): float(r["time"]) for r in present}
-    for dx in ("-4.0", "0.0", "4.0"):
-        assert by[(dx, "250.0")] >= by[(dx, "150.0")]
 
 
 def test_two_runs_and_one_or_two_workers_give_identical_tables(bench_runs):

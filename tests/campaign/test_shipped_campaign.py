@@ -22,8 +22,9 @@ def test_it_covers_offsets_sizes_a_missing_ring_a_jammed_finger_and_a_link_loss(
     for sc in c.scenarios:  # every scenario says what the PLC must reach
         exp = expectations(c, sc)
         faulty = sc.params.get("fault", "none") != "none" and c.faults[sc.params["fault"]].kind != "link_lost"
-        if faulty:
-            assert (exp["outcome"], exp["fault"], exp["grip"], exp["grips"]) == ("stopped", "cycle_fault", "missed", 0)
+        if faulty:  # no grip confirmed, the cycle stopped (a missing ring: the miss detected twice)
+            assert (exp["outcome"], exp["fault"], exp["grips"]) == ("stopped", "cycle_fault", 0)
+            assert exp["grip"] in ("missed", "none")
         else:
             assert (exp["outcome"], exp["grip"], exp["grips"]) == ("completed", "confirmed", 2)  # outside and inside
 
