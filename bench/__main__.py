@@ -15,6 +15,7 @@ BENCHMARKS = {
     "rapid": "bench.rapid_polling",  # RAPID polling loops offline: wall time per simulated second
     "opcua": "bench.opcua",  # OPC UA vs Modbus on the same cell: latency, change delay, 1000 monitored items
     "view": "bench.view",  # the live page and recording: late steps, page updates per s, recording cost per step
+    "map": "bench.signal_map",  # twin map from the static signal table vs from a running cell
 }
 
 

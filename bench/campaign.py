@@ -42,7 +42,7 @@ grip = "confirmed"
 
 
 def measure(campaign, backend, out: Path) -> dict:
-    from twin.campaign import run_campaign
+    from twin_app.campaign import run_campaign
 
     t0 = time.perf_counter()
     result = run_campaign(campaign, backend, out, quiet=True)
@@ -60,7 +60,7 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--no-cluster", action="store_true", help="skip the loopback Dask cluster")
     args = parser.parse_args(argv)
 
-    from twin.campaign import DaskBackend, LocalBackend, load_campaign
+    from twin_app.campaign import DaskBackend, LocalBackend, load_campaign
 
     with tempfile.TemporaryDirectory(prefix="bench-campaign-") as tmp:
         tmp = Path(tmp)
@@ -72,7 +72,7 @@ def main(argv: list[str]) -> int:
             rows[f"local, {workers} worker{'s' if workers > 1 else ''}"] = measure(campaign, LocalBackend(workers), tmp / f"local{workers}")
         if not args.no_cluster:
             try:
-                from twin.campaign.loopback import loopback_cluster
+                from twin_app.campaign.loopback import loopback_cluster
             except ImportError:
                 print("(no Dask: pip install 'gripper-twin[cluster]' for the cluster rows)")
             else:

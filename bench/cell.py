@@ -25,7 +25,7 @@ def in_process(cycles: int) -> dict:
     from plc_client import ring_rig
     from plc_client.cell_demo import operator
     from plc_client.scan import Combined, ScanCycle, TwinIO
-    from twin.cell import open_cell
+    from twin_app.cell import open_cell
 
     t0 = time.perf_counter()
     with open_cell(STATION) as twin:

@@ -41,7 +41,7 @@ from .errors import PlcClientError
 from .grip_sequence import INSIDE, Fault, Phase
 from .scan import Combined, ScanCycle, plc_logic
 
-from twin.native_output import quiet_native_output
+from twin.core.native_output import quiet_native_output
 
 # plc_client.testing (twin_server) is imported where the demo starts the server, not here: importing it
 # early keeps pytest from rewriting it when a test suite loads it as a plugin (PytestAssertRewriteWarning).

@@ -31,7 +31,6 @@ from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotW
                      SignalValueError, UnknownSignalError, ValueOutOfRangeError)
 from .scan import LocalSignals
 
-from twin.native_output import quiet_native_output
 
 from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
                                       INPUT_REGISTER, LOCKSTEP, MAP_CRC, STEP, TABLES, TYPE_LIMITS, WATCHDOG_MS, Entry,
@@ -121,19 +120,15 @@ class RegisterMap:
 
     @classmethod
     def from_station(cls, station: str | Path) -> "RegisterMap":
-        """Build the map the server would serve for this station (with the server's own map builder)."""
-        with quiet_native_output(stderr=True):  # importing pybullet prints a banner on stderr, connecting argv[0] on stdout
-            from twin.core.errors import TwinError
-            from twin.modbus import register_map as rm
+        """The map the server serves for this station, from the station's static signal table (the server's own
+        map builder; no physics starts)."""
+        from twin.core.errors import TwinError
+        from twin.modbus import register_map as rm
 
-            try:
-                built = rm.build_map(station)
-            except (TwinError, rm.MapError) as exc:
-                error = str(exc)
-            else:
-                error = None
-        if error is not None:
-            raise MapError(error)
+        try:
+            built = rm.build_map(station)
+        except (TwinError, rm.MapError) as exc:
+            raise MapError(str(exc)) from None
         return cls(built.entries, {"station": built.station}, f"station {built.station!r}")
 
     @property

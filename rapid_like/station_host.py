@@ -29,7 +29,11 @@ import math
 from typing import Callable, Sequence
 
 from twin.core.errors import MotionError, TwinError
-from twin.core.signals import BOOL, FLOAT, INPUT, INT, OUTPUT, SignalSpec
+from twin.core.signal_table import (CONTROLLER_SIGNAL_TYPE as SIGNAL_TYPE, RAPID_ERROR as SIGNAL_ERROR,
+                                    RAPID_LINE as SIGNAL_LINE, RAPID_RUNNING as SIGNAL_RUNNING,
+                                    RAPID_START as SIGNAL_START, RAPID_STOP as SIGNAL_STOP, check_wiring,
+                                    controller_signals)
+from twin.core.signals import BOOL, INT
 from twin.core.station import ControllerSpec
 
 from .builtins import ERRORS
@@ -38,10 +42,6 @@ from .errors import ExecError
 from .host import MotionRequest, SignalInfo
 from .values import Record, record
 
-SIGNAL_TYPE = {"DI": BOOL, "DO": BOOL, "AI": FLOAT, "AO": FLOAT, "GI": INT, "GO": INT}
-# The program's own signals, after the configured I/O: start and stop it from outside, see how it runs.
-SIGNAL_START, SIGNAL_STOP, SIGNAL_RUNNING, SIGNAL_ERROR, SIGNAL_LINE = (
-    "rapid.start", "rapid.stop", "rapid.running", "rapid.error", "rapid.line")
 STATION_LOOP_BUDGET = 200  # time-less loop iterations per simulation step (see the module docstring)
 
 
@@ -178,46 +178,12 @@ class TwinHost:
         self.printed.append(text)
 
 
-def settable_from_outside(sig) -> bool:
-    """Who may set a controller signal from outside (a PLC, a test, an engineer): its inputs that no twin output
-    feeds (DI, AI, GI: the PLC's outputs to the robot), and outputs marked `settable` (RobotStudio's I/O
-    simulator, e.g. the thesis's path signals). The robot's other outputs are read-only, like every output."""
-    if sig.drives or sig.source:
-        return False
-    return sig.type in ("DI", "AI", "GI") or sig.settable
-
-
-def _wiring(sig) -> str:
-    if sig.drives:
-        return f"drives {sig.drives}"
-    if sig.source:
-        return f"reads {sig.source}"
-    if sig.type in ("DO", "AO", "GO"):
-        return "set by the robot program" + (", and from outside (I/O simulator)" if sig.settable else "")
-    return "set from outside"
-
-
 class ControllerDevice:
     """Steps the controller with the twin and publishes the controller's signals in the signal table."""
 
     def __init__(self, host: TwinHost, controller: Controller):
         self.host, self.controller = host, controller
-        specs = []
-        for sig in host.spec.io:
-            specs.append(SignalSpec(sig.name, INPUT if settable_from_outside(sig) else OUTPUT, SIGNAL_TYPE[sig.type],
-                                    sig.unit, description=f"robot controller {sig.type} {sig.name} ({_wiring(sig)})",
-                                    group="controller"))
-        specs += [
-            SignalSpec(SIGNAL_START, INPUT, BOOL, group="controller",
-                       description="a rising edge (re)starts the RAPID program from its entry routine (VAR data anew, PERS kept)"),
-            SignalSpec(SIGNAL_STOP, INPUT, BOOL, group="controller", description="a rising edge stops the RAPID program where it is"),
-            SignalSpec(SIGNAL_RUNNING, OUTPUT, BOOL, group="controller", description="the RAPID program is running (or waiting)"),
-            SignalSpec(SIGNAL_ERROR, OUTPUT, BOOL, group="controller",
-                       description="the RAPID program stopped on a runtime error (the server's log says where)"),
-            SignalSpec(SIGNAL_LINE, OUTPUT, INT, min=0, max=65535, group="controller",
-                       description="the line of the program's module the robot controller waits at (0: none)"),
-        ]
-        self.signals = tuple(specs)
+        self.signals = controller_signals(host.spec)
         self._requests = {SIGNAL_START: False, SIGNAL_STOP: False}  # as written
         self._seen = dict(self._requests)  # as acted on
 
@@ -254,28 +220,6 @@ class ControllerDevice:
         pass
 
 
-def check_wiring(twin, spec: ControllerSpec) -> None:
-    """Every `drives` names an input of the twin and every `source` an output, before anything runs."""
-    from twin.core.errors import StationError
-    from twin.core.signals import INPUT as TWIN_INPUT
-
-    file = str(twin.station.file)
-    known = {s.name: s for s in twin.signals}
-    for i, sig in enumerate(spec.io):
-        for key, want in (("drives", TWIN_INPUT), ("source", None)):
-            target = getattr(sig, key)
-            if not target:
-                continue
-            found = known.get(target)
-            if found is None:
-                names = [s.name for s in twin.signals if (s.direction == TWIN_INPUT) == (want == TWIN_INPUT)]
-                raise StationError(file, f"controller.io[{i}].{key}",
-                                   f"{sig.name}: the twin has no signal {target!r} (it has: {', '.join(names)})")
-            if want == TWIN_INPUT and found.direction != TWIN_INPUT:
-                raise StationError(file, f"controller.io[{i}].{key}",
-                                   f"{sig.name}: {target!r} is an output of the twin; an output can only be a `source`")
-
-
 def attach_controller(twin, on_event: Callable[[dict], None] | None = None, autostart: bool = True,
                       entry: str | None = None) -> Controller:
     """Load the station's RAPID program and make it the twin's robot controller.
@@ -284,7 +228,7 @@ def attach_controller(twin, on_event: Callable[[dict], None] | None = None, auto
     spec = twin.station.controller
     if spec is None:
         raise TwinError(f"station {twin.station.name!r} has no [controller]")
-    check_wiring(twin, spec)
+    check_wiring(twin.station, twin.signals)
     host = TwinHost(twin, spec)
     program = load_task([spec.program, *spec.modules]) if spec.modules else load_program(spec.program)
     controller = Controller(program, host, entry=entry or spec.entry, on_event=on_event, autostart=autostart,

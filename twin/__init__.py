@@ -1,5 +1,7 @@
 """gripper-twin: the digital twin of a robot cell with a gripper.
 
-`twin.core` is the stepped simulation (no sockets, no wall clock); `twin.modbus` serves it on Modbus/TCP;
-`twin.pacing` advances it in real time or in lockstep; `twin.cli` is the `twin` command.
+`twin.core` is the stepped simulation (no sockets, no wall clock) and its static signal table;
+`twin.exchange` is the contract front ends use (snapshots out, validated writes in); `twin.modbus` is the
+Modbus/TCP front end; `twin.pacing` advances a cell in real time or in lockstep. The application that
+assembles them (the `twin` command, the cell) is `twin_app`, above this package.
 """

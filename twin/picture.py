@@ -140,7 +140,8 @@ def save_png(img: np.ndarray, path: str | Path) -> Path:
     return path
 
 
-def cmd_snapshot(args) -> int:
+def cmd_snapshot(args, open_cell) -> int:
+    """`twin snapshot`; `open_cell(station)` (the application's) gives a station's cell."""
     out = Path(args.output)
     if out.suffix.lower() != ".png":
         raise TwinError(f"{out}: twin snapshot writes a .png")
@@ -160,16 +161,14 @@ def cmd_snapshot(args) -> int:
         with RecordingCamera(rec) as cam:
             img = cam.picture(t, **size)
     else:
-        from .cell import open_cell
-
-        twin = open_cell(source)
+        cell = open_cell(source)
         try:
             if args.at:
                 if args.at < 0 or math.isnan(args.at):
                     raise TwinError(f"--at {args.at:g}: a time in s, at least 0")
-                twin.step(round(args.at / twin.dt))
-            img = render(twin, highlight=twin.read("GrippedPart") or "", **size)
+                cell.step(round(args.at / cell.dt))
+            img = render(cell.twin, highlight=cell.read("GrippedPart") or "", **size)
         finally:
-            twin.close()
+            cell.close()
     print(save_png(img, out))
     return 0

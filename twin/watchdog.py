@@ -32,9 +32,8 @@ import logging
 import math
 from collections.abc import Callable, Mapping
 
-from twin.core.signals import BOOL, OUTPUT, SignalSpec
+from twin.core.signal_table import COMM_LOST, watchdog_signals
 
-COMM_LOST = "comm.lost"
 SAFE_STATES = ("hold", "open", "stop")
 
 
@@ -50,10 +49,7 @@ class Watchdog:
         self.safe_state = safe_state
         self.open_setpoints = dict(open_setpoints or {})
         self.log = log or (lambda text: logging.getLogger("twin.serve").warning(text))
-        self.signals = (SignalSpec(COMM_LOST, OUTPUT, BOOL, group="cell",
-                                   description="comm-loss watchdog: no request from any client for the watchdog time; "
-                                               f"the gripper went to its safe state ({safe_state}); "
-                                               "cleared by the next request"),)
+        self.signals = watchdog_signals(safe_state)  # declared in the static signal table
         self.clock: Callable[[], float] | None = None  # None: the twin's simulated time
         self.twin = None
         self.last_seen: dict[str, float] = {}  # source -> when its last request came

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from plc_client.testing import free_port
-from twin.campaign import DaskBackend, LocalBackend, load_campaign, run_campaign
-from twin.campaign.loopback import loopback_cluster
+from twin_app.campaign import DaskBackend, LocalBackend, load_campaign, run_campaign
+from twin_app.campaign.loopback import loopback_cluster
 
 distributed = pytest.importorskip("distributed", reason="the [cluster] extra (dask[distributed]) is not installed")
 

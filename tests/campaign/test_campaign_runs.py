@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from twin.campaign import LocalBackend, load_campaign, run_campaign
+from twin_app.campaign import LocalBackend, load_campaign, run_campaign
 
 DATA = Path(__file__).resolve().parent / "data"
 BENCH = DATA / "bench.toml"
@@ -141,7 +141,7 @@ def test_the_command_prints_a_summary_and_exits_by_the_verdict(tmp_path):
 
 
 def test_without_a_fork_server_each_scenario_is_a_fresh_interpreter(tmp_path, monkeypatch):
-    import twin.campaign.backends as backends
+    import twin_app.campaign.backends as backends
 
     monkeypatch.setattr(backends, "_may_fork", lambda: False)
     campaign = load_campaign(DATA / "crash.toml")

@@ -4,9 +4,9 @@ from pathlib import Path
 
 import pytest
 
-from twin.campaign import load_campaign, run_scenario
-from twin.campaign.expressions import Expression, ExpressionError
-from twin.campaign.spec import SpecError
+from twin_app.campaign import load_campaign, run_scenario
+from twin_app.campaign.expressions import Expression, ExpressionError
+from twin_app.campaign.spec import SpecError
 
 BENCH_STATION = Path(__file__).resolve().parents[1] / "plc" / "stations" / "ring_bench"
 HEAD = f"""

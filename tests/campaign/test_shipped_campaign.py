@@ -5,8 +5,8 @@ import csv
 import pytest
 
 from tests.conftest import STATIONS
-from twin.campaign import LocalBackend, load_campaign, run_campaign
-from twin.campaign.verdict import expectations
+from twin_app.campaign import LocalBackend, load_campaign, run_campaign
+from twin_app.campaign.verdict import expectations
 
 SHIPPED = STATIONS / "ring_rig_plc" / "campaign.toml"
 

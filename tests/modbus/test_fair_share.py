@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import struct
 
+from twin.exchange import Exchange
 from twin.modbus.bridge import TwinBridge
 from twin.modbus.register_map import build_register_map
 from twin.modbus.server import ModbusServer
@@ -35,8 +36,9 @@ def test_all_connections_share_one_budget_per_step_period_evenly_and_an_idle_one
     async def run():
         twin = StandIn()
         rmap = build_register_map(twin.signals, "stand-in")
-        bridge = TwinBridge(twin, rmap, log=lambda text: None)
-        bridge.runner = LockstepRunner(bridge.step)
+        exchange = Exchange(twin, log=lambda text: None)
+        bridge = TwinBridge(exchange, rmap)
+        exchange.runner = LockstepRunner(exchange.step)
         clock = Clock()
         server = ModbusServer(rmap, bridge, requests_per_step=120, step_period=0.02, clock=clock, log=lambda t: None)
         _, port = await server.start("127.0.0.1", 0)

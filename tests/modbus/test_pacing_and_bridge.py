@@ -7,6 +7,7 @@ import time
 
 from twin.core.errors import SignalRangeError
 from twin.core.signals import BOOL, FLOAT, INPUT, OUTPUT, SignalSpec
+from twin.exchange import Exchange
 from twin.modbus.bridge import TwinBridge
 from twin.modbus.register_map import build_register_map
 from twin.modbus.server import ModbusServer
@@ -103,9 +104,10 @@ def test_a_failing_step_sets_the_fault_bit_freezes_the_outputs_and_writes_get_ex
         twin = StandIn(broken_at=2)
         rmap = build_register_map(twin.signals, "stand-in")
         logs = []
-        bridge = TwinBridge(twin, rmap, log=logs.append)
-        runner = LockstepRunner(bridge.step)
-        bridge.runner = runner
+        exchange = Exchange(twin, log=logs.append)
+        bridge = TwinBridge(exchange, rmap)
+        runner = LockstepRunner(exchange.step)
+        exchange.runner = runner
         server = ModbusServer(rmap, bridge, log=logs.append)
         _, port = await server.start("127.0.0.1", 0)
         task = asyncio.ensure_future(runner.run())
@@ -140,7 +142,8 @@ def test_a_failing_step_sets_the_fault_bit_freezes_the_outputs_and_writes_get_ex
 def test_a_write_reads_back_at_once_and_no_publish_undoes_it_before_it_is_applied():
     twin = StandIn()
     rmap = build_register_map(twin.signals, "stand-in")
-    bridge = TwinBridge(twin, rmap)
+    exchange = Exchange(twin)
+    bridge = TwinBridge(exchange, rmap)
     target, go = rmap["target"], rmap["go"]
 
     def holding(entry) -> int:
@@ -149,10 +152,10 @@ def test_a_write_reads_back_at_once_and_no_publish_undoes_it_before_it_is_applie
     assert bridge.submit([(target, 0.05), (go, True)]) == 0
     assert holding(target) == 5000 and bridge.images.coils[go.address] == 1  # at once
     assert twin.values["target"] == 0.0  # not applied yet: that is the next step's job
-    bridge.publish()  # a publish before the step (whoever calls it) keeps what was written
+    exchange.publish()  # a publish before the step (whoever calls it) keeps what was written
     assert holding(target) == 5000 and bridge.images.coils[go.address] == 1
     x = rmap["x"]
     assert struct.unpack_from(">H", bridge.images.input_registers, 2 * x.address)[0] == 0  # outputs: last step
-    assert bridge.step()
+    assert exchange.step()
     assert twin.values["target"] == 0.05 and holding(target) == 5000
     assert struct.unpack_from(">H", bridge.images.input_registers, 2 * x.address)[0] == 5000

@@ -34,7 +34,7 @@ class Clock:
 
 
 def cell(tmp_path, watchdog: str):
-    from twin.cell import open_cell
+    from twin_app.cell import open_cell
 
     twin = open_cell(station(tmp_path, watchdog))
     return twin, twin.watchdog
@@ -208,7 +208,7 @@ def test_the_plc_clients_heartbeat_keeps_a_quiet_plc_alive_and_without_it_the_li
 
 
 def test_the_robot_program_sees_the_lost_link_on_a_di(tmp_path):
-    from twin.cell import open_cell
+    from twin_app.cell import open_cell
 
     (tmp_path / "watch.mod").write_text('MODULE watch\n  PROC main()\n    WaitDI diCommLost, 1;\n'
                                         '    TPWrite "link lost";\n  ENDPROC\nENDMODULE\n')

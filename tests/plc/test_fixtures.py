@@ -7,7 +7,7 @@ from plc_client import ScanCycle, plc_logic
 from tests.plc.conftest import BENCH
 
 pytest_plugins = ["plc_client.testing"]
-pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.cli") is None,
+pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.front_end") is None,
                                 reason="twin serve is not there yet (twin/modbus/cli.py)")
 
 

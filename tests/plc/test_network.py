@@ -13,7 +13,7 @@ from plc_client.errors import ConnectionFailedError, MapError, UnknownSignalErro
 from plc_client.testing import free_port, twin_server
 from tests.plc.conftest import BENCH, RING_FORCES, STATIONS, ring_sequence
 
-pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.cli") is None,
+pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.front_end") is None,
                                 reason="twin serve is not there yet (twin/modbus/cli.py)")
 EMPTY = BENCH.with_name("ring_bench_empty")  # the ring lies 2.4 m away: every grip misses
 

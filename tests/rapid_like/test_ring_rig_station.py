@@ -11,7 +11,7 @@ import shutil
 import pytest
 
 from tests.conftest import STATIONS
-from twin.cell import open_cell
+from twin_app.cell import open_cell
 from twin.core.errors import StationError
 
 RIG = STATIONS / "ring_rig"
@@ -27,21 +27,21 @@ def run_until(twin, done, limit_s: float) -> None:
 
 def test_the_program_carries_the_ring_right_to_left_and_back_in_physics():
     events = []
-    with open_cell(RIG, on_event=events.append, entry="Path_FullAutoRun") as twin:
-        ctl = twin.controller
+    with open_cell(RIG, on_event=events.append, entry="Path_FullAutoRun") as cell:
+        ctl = cell.controller
         grips = []  # (t, gripped, ring xy) at every change of doGripped
         last = False
 
         def watch():
             nonlocal last
-            if twin.read("doGripped") != last:
-                last = twin.read("doGripped")
-                grips.append((round(twin.time, 3), last, twin.object_pose("ring")[0][:2]))
+            if cell.read("doGripped") != last:
+                last = cell.read("doGripped")
+                grips.append((round(cell.time, 3), last, cell.twin.object_pose("ring")[0][:2]))
             return ctl.state == "completed"
 
-        run_until(twin, watch, 60.0)
+        run_until(cell, watch, 60.0)
         assert [e for e in events if e["type"] in ("error", "end")] == [
-            {"t": pytest.approx(twin.time - twin.dt, abs=0.013), "type": "end", "reason": "completed"}]
+            {"t": pytest.approx(cell.time - cell.dt, abs=0.013), "type": "end", "reason": "completed"}]
         # gripped on the right, released on the left, gripped on the left, released on the right
         assert [g for _, g, _ in grips] == [True, False, True, False]
         where = [xy for _, _, xy in grips]
@@ -51,22 +51,22 @@ def test_the_program_carries_the_ring_right_to_left_and_back_in_physics():
         ao1 = [(e["t"], e["value"]) for e in events if e.get("signal") == "aoAxis1"]
         assert [v for t, v in ao1 if t <= grips[0][0]][-1] == 319  # touching at 320, pressing (by force) at 319
         assert [v for t, v in ao1 if grips[1][0] < t <= grips[2][0]][-1] == 201  # touching at 200, pressing at 201
-        (x, y, z), q = twin.object_pose("ring")
+        (x, y, z), q = cell.twin.object_pose("ring")
         assert math.dist((x, y, z), (*RIGHT, 0.18)) < 0.005  # back where it started, lying flat
         assert abs(q[0]) < 0.01 and abs(q[1]) < 0.01
-        assert twin.read("L2.actual") == pytest.approx(0.330, abs=0.001)  # open for the next pick
+        assert cell.read("L2.actual") == pytest.approx(0.330, abs=0.001)  # open for the next pick
 
 
 def test_init_waits_for_a_path_signal_like_the_io_simulator():
-    with open_cell(RIG) as twin:
-        twin.step(50)
-        assert not twin.read("robot.busy") and twin.read("L2") == pytest.approx(0.35)  # idle in Main
-        twin.write("movePickOutside", True)
-        run_until(twin, lambda: twin.read("doGripped"), 10.0)
-        assert not twin.read("movePickOutside")  # Path_PickOutside resets its signal
-        assert twin.read("aoAxis1") == 319 and twin.read("L2") == pytest.approx(0.319)  # 1 mm past: pressing
-        run_until(twin, lambda: twin.object_pose("ring")[0][2] > 0.5, 5.0)  # lifted to the approach
-        assert twin.read("diGripped") and twin.read("GrippedPart") == "ring"
+    with open_cell(RIG) as cell:
+        cell.step(50)
+        assert not cell.read("robot.busy") and cell.read("L2") == pytest.approx(0.35)  # idle in Main
+        cell.write("movePickOutside", True)
+        run_until(cell, lambda: cell.read("doGripped"), 10.0)
+        assert not cell.read("movePickOutside")  # Path_PickOutside resets its signal
+        assert cell.read("aoAxis1") == 319 and cell.read("L2") == pytest.approx(0.319)  # 1 mm past: pressing
+        run_until(cell, lambda: cell.twin.object_pose("ring")[0][2] > 0.5, 5.0)  # lifted to the approach
+        assert cell.read("diGripped") and cell.read("GrippedPart") == "ring"
 
 
 def copy_rig(tmp_path, old: str | None = None, new: str | None = None):
@@ -97,8 +97,8 @@ def test_the_station_binding_gives_a_busy_loop_a_small_budget_per_step():
     from rapid_like.controller import DEFAULT_LOOP_BUDGET
     from rapid_like.station_host import STATION_LOOP_BUDGET
 
-    with open_cell(RIG) as twin:
-        assert twin.controller.interp.loop_budget == STATION_LOOP_BUDGET < DEFAULT_LOOP_BUDGET
+    with open_cell(RIG) as cell:
+        assert cell.controller.interp.loop_budget == STATION_LOOP_BUDGET < DEFAULT_LOOP_BUDGET
 
 
 TOOL_AND_WOBJ = """MODULE ToolWobj
@@ -122,11 +122,11 @@ def test_motions_and_crobt_use_the_programs_tooldata_and_wobjdata(tmp_path):
     toml = station / "station.toml"
     toml.write_text(toml.read_text().replace('program = "ring_rig.mod"', 'program = "tool_wobj.mod"')
                     .replace('entry = "Init"', 'entry = "main"'))
-    with open_cell(station) as twin:
-        run_until(twin, lambda: twin.controller.state == "completed", 20.0)
+    with open_cell(station) as cell:
+        run_until(cell, lambda: cell.controller.state == "completed", 20.0)
         # the long tool's TCP (450 mm out) is 500 mm above the pallet's top: the station's tcp (350 mm) 100 mm higher
-        assert twin.tcp_pose().position == pytest.approx((1.6, -0.8, 0.15 + 0.5 + 0.1), abs=0.001)
-        data = twin.controller.interp.globals
+        assert cell.twin.tcp_pose().position == pytest.approx((1.6, -0.8, 0.15 + 0.5 + 0.1), abs=0.001)
+        data = cell.controller.interp.globals
         here = data["phere"].value.fields["trans"]
         assert [float(here.fields[k]) for k in "xyz"] == pytest.approx([0, 0, 500], abs=0.5)  # in wPallet, for tLong
         world = data["pworld"].value.fields["trans"]
@@ -134,31 +134,31 @@ def test_motions_and_crobt_use_the_programs_tooldata_and_wobjdata(tmp_path):
 
 
 def test_the_program_can_be_stopped_and_started_again_from_its_entry_routine_by_signals():
-    with open_cell(RIG) as twin:
-        twin.step(10)
-        assert twin.read("rapid.running") and not twin.read("rapid.error")
-        assert twin.read("rapid.line") > 0  # waiting in Main (the WaitTime)
-        twin.write("rapid.stop", True)
-        twin.step(2)
-        assert not twin.read("rapid.running") and twin.read("rapid.line") == 0
-        twin.write("movePickOutside", True)
-        twin.step(100)
-        assert twin.read("movePickOutside") and twin.read("L2") == pytest.approx(0.35)  # nothing runs
-        twin.write("rapid.start", True)  # from Init again: it sees the request and picks the ring
-        run_until(twin, lambda: twin.read("doGripped"), 10.0)
-        assert twin.read("rapid.running") and not twin.read("movePickOutside")
+    with open_cell(RIG) as cell:
+        cell.step(10)
+        assert cell.read("rapid.running") and not cell.read("rapid.error")
+        assert cell.read("rapid.line") > 0  # waiting in Main (the WaitTime)
+        cell.write("rapid.stop", True)
+        cell.step(2)
+        assert not cell.read("rapid.running") and cell.read("rapid.line") == 0
+        cell.write("movePickOutside", True)
+        cell.step(100)
+        assert cell.read("movePickOutside") and cell.read("L2") == pytest.approx(0.35)  # nothing runs
+        cell.write("rapid.start", True)  # from Init again: it sees the request and picks the ring
+        run_until(cell, lambda: cell.read("doGripped"), 10.0)
+        assert cell.read("rapid.running") and not cell.read("movePickOutside")
 
 
 def test_the_robots_outputs_are_read_only_from_outside_and_its_inputs_writable():
     from twin.core.errors import SignalError
 
-    with open_cell(STATIONS / "ring_rig_plc") as twin:
-        kinds = {s.name: s.direction for s in twin.signals}
+    with open_cell(STATIONS / "ring_rig_plc") as cell:
+        kinds = {s.name: s.direction for s in cell.signals}
         assert kinds["doGripRequest"] == kinds["goCycle"] == kinds["aoFingerReady"] == "output"  # robot DO/GO/AO
         assert kinds["diGripDone"] == kinds["diGripOk"] == "input"  # the PLC's answers
         assert kinds["fullAutoRun"] == "input"  # settable = true: the I/O simulator's signal
         with pytest.raises(SignalError, match="doGripRequest.*output"):
-            twin.write("doGripRequest", True)
+            cell.write("doGripRequest", True)
 
 
 def test_settable_is_only_for_outputs_that_drive_nothing(tmp_path):
@@ -169,13 +169,13 @@ def test_settable_is_only_for_outputs_that_drive_nothing(tmp_path):
 
 def test_a_gripper_plc_that_does_not_answer_stops_the_cycle_with_a_clear_message():
     events = []
-    with open_cell(STATIONS / "ring_rig_plc", on_event=events.append) as twin:  # no PLC connected
-        twin.write("fullAutoRun", True)
-        run_until(twin, lambda: not twin.read("rapid.running"), 40.0)
+    with open_cell(STATIONS / "ring_rig_plc", on_event=events.append) as cell:  # no PLC connected
+        cell.write("fullAutoRun", True)
+        run_until(cell, lambda: not cell.read("rapid.running"), 40.0)
         printed = [e["text"] for e in events if e["type"] == "print"]
         assert printed[-1] == "The gripper PLC did not answer the finger preparation request within 30 s"
-        assert twin.read("doCycleFault") and not twin.read("fullAutoRun") and not twin.read("doPrepare")
-        assert twin.read("L2") == pytest.approx(0.35)  # nobody moved the fingers
+        assert cell.read("doCycleFault") and not cell.read("fullAutoRun") and not cell.read("doPrepare")
+        assert cell.read("L2") == pytest.approx(0.35)  # nobody moved the fingers
 
 
 STATION_DATA = """MODULE station_data(SYSMODULE)
@@ -203,10 +203,10 @@ def test_a_station_controller_lists_several_modules_and_answers_its_dialogs(tmp_
                                              'program = "uses_data.mod"\nmodules = ["station_data.sys"]\n'
                                              'answers = ["100"]')
                     .replace('entry = "Init"', 'entry = "main"'))
-    with open_cell(station) as twin:
-        run_until(twin, lambda: twin.controller.state == "completed", 20.0)
+    with open_cell(station) as cell:
+        run_until(cell, lambda: cell.controller.state == "completed", 20.0)
         # the answer raised the target 100 mm: the long tool's TCP 600 mm above the pallet's top, the flange 450 mm more
-        assert twin.tcp_pose().position == pytest.approx((1.6, -0.8, 0.15 + 0.6 + 0.1), abs=0.001)
+        assert cell.twin.tcp_pose().position == pytest.approx((1.6, -0.8, 0.15 + 0.6 + 0.1), abs=0.001)
 
 
 def test_a_missing_module_of_the_station_controller_names_the_key(tmp_path):
@@ -238,10 +238,10 @@ def test_a_zone_lets_the_program_go_on_as_the_robot_enters_it_and_fine_stops_at_
     toml = station / "station.toml"
     toml.write_text(toml.read_text().replace('program = "ring_rig.mod"', 'program = "zones.mod"')
                     .replace('entry = "Init"', 'entry = "main"'))
-    with open_cell(station) as twin:
-        run_until(twin, lambda: twin.controller.state == "completed", 30.0)
-        at = twin.controller.interp.globals["pat"].value.fields["trans"]
+    with open_cell(station) as cell:
+        run_until(cell, lambda: cell.controller.state == "completed", 30.0)
+        at = cell.controller.interp.globals["pat"].value.fields["trans"]
         # the program read the robot's position on its way to x = 200 mm: within z50's 50 mm of the point (a
         # step of 12 ms at 200 mm/s is 2.4 mm), or at the point for fine
         assert low <= float(at.fields["x"]) <= high
-        assert twin.tcp_pose().position[1] == pytest.approx(-0.8 + 0.2, abs=0.001)  # then on to the last point
+        assert cell.twin.tcp_pose().position[1] == pytest.approx(-0.8 + 0.2, abs=0.001)  # then on to the last point

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import STATIONS
-from twin.cli import main as twin_main
+from twin_app.cli import main as twin_main
 from twin.core import Twin
 from twin.recording import Recording, record
 

@@ -3,13 +3,15 @@
 It imports pybullet and numpy, never sockets, asyncio or time: its clock is step count x dt.
 """
 
-from .errors import MechanismError, MotionError, SignalError, SignalRangeError, StationError, TwinError
+from .errors import (MechanismError, MotionError, SignalError, SignalRangeError, SignalTypeError, StationError,
+                     TwinError)
 
 __all__ = ["Twin", "Station", "load_station", "Mechanism", "load_mechanism", "SignalSpec", "TwinError",
-           "StationError", "MechanismError", "SignalError", "SignalRangeError", "MotionError"]
+           "StationError", "MechanismError", "SignalError", "SignalRangeError", "SignalTypeError",
+           "MotionError", "station_signals"]
 
 _LAZY = {"Twin": ".twin", "Station": ".station", "load_station": ".station", "Mechanism": ".mechanism",
-         "load_mechanism": ".mechanism", "SignalSpec": ".signals"}
+         "load_mechanism": ".mechanism", "SignalSpec": ".signals", "station_signals": ".signal_table"}
 
 
 def __getattr__(name: str):

@@ -4,6 +4,7 @@
     ├── StationError          a station file or a model it names is wrong (names file and key)
     ├── MechanismError        a gripper URDF cannot be turned into a mechanism
     ├── SignalError           unknown signal name, or a write to an output
+    │   ├── SignalTypeError   a value of the wrong type for the signal (text for a number, NaN, ...)
     │   └── SignalRangeError  a value outside the signal's range (never clamped)
     └── MotionError           the robot cannot reach a target (names the target)
 """
@@ -32,6 +33,14 @@ class SignalError(TwinError):
     def __init__(self, name: str, message: str):
         self.signal = name
         super().__init__(f"signal {name!r}: {message}")
+
+
+class SignalTypeError(SignalError):
+    """A value of the wrong type for a signal (a number for a bool, text for a number, NaN). Rejected."""
+
+    def __init__(self, name: str, value, expected: str):
+        self.value, self.expected = value, expected
+        super().__init__(name, f"needs {expected}, not {value!r}")
 
 
 class SignalRangeError(SignalError):

@@ -39,13 +39,11 @@ import pybullet
 
 from .errors import SignalRangeError
 from .mechanism import JointInput, Mechanism
+from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # noqa: F401 (what the signals mean)
 from .station import GripperSpec
 from .world import COLLISION_MARGIN
 
-IN_POSITION_TOLERANCE = {"m": 0.0002, "rad": 0.002}  # 0.2 mm, ~0.1 degree
-MOVING_SPEED = {"m": 0.001, "rad": 0.005}  # below this the axis counts as standing still
 DEFAULT_VELOCITY = {"m": 0.1, "rad": 1.0}  # when the URDF gives no velocity limit
-DEFAULT_EFFORT = {"m": 100.0, "rad": 10.0}  # when the URDF gives no effort limit
 FULL_FORCE_ERROR = {"m": 0.001, "rad": 0.01}  # default stiffness: the effort limit at this following error
 HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
 POSITION_GAIN = 0.3  # the velocity loop takes this share of the following error out per substep

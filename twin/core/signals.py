@@ -7,7 +7,11 @@ is stable too.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from numbers import Integral, Real
+
+from .errors import SignalError, SignalRangeError, SignalTypeError
 
 INPUT = "input"
 OUTPUT = "output"
@@ -35,3 +39,42 @@ class SignalSpec:
     @property
     def writable(self) -> bool:
         return self.direction == INPUT
+
+    def check(self, value):
+        """A value written to this signal, normalised (bool, float, int or the enumeration's text), or the error
+        every front end reports for it: SignalError for an output, SignalTypeError for a value of the wrong
+        type (a number for a bool, text for a number, NaN), SignalRangeError outside min..max (never clamped).
+        The one validation of writes: the twin, Modbus, OPC UA and the view all go through it."""
+        if self.direction != INPUT:
+            raise SignalError(self.name, "is an output of the twin and cannot be written")
+        if self.type == BOOL:
+            if isinstance(value, (bool, Integral)) and value in (0, 1):
+                return bool(value)
+            raise SignalTypeError(self.name, value, "a bool (True/False, 1/0)")
+        if self.type == ENUM:
+            if isinstance(value, str) and value in self.choices:
+                return value
+            if isinstance(value, Integral) and not isinstance(value, bool) and 0 <= value < len(self.choices):
+                return self.choices[value]
+            raise SignalTypeError(self.name, value, "one of " + ", ".join(repr(c) for c in self.choices))
+        if isinstance(value, bool) or not isinstance(value, Real):
+            raise SignalTypeError(self.name, value, "a number")
+        if not math.isfinite(value):
+            raise SignalTypeError(self.name, value, "a finite number")
+        if self.type == INT:
+            if value != int(value):
+                raise SignalTypeError(self.name, value, "a whole number")
+            value = int(value)
+        else:
+            value = float(value)
+        lo = -math.inf if self.min is None else self.min
+        hi = math.inf if self.max is None else self.max
+        # a range end sent in other units (deg, mm) and converted back is the end, within a rounding's width
+        slack = 1e-9 * max(1.0, *(abs(v) for v in (self.min, self.max) if v is not None))
+        if hi < value <= hi + slack:
+            value = type(value)(hi)
+        elif lo - slack <= value < lo:
+            value = type(value)(lo)
+        if not lo <= value <= hi:
+            raise SignalRangeError(self.name, value, lo, hi, self.unit)
+        return value

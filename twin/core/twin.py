@@ -14,13 +14,13 @@ from pathlib import Path
 from typing import Protocol
 
 from .errors import MotionError, SignalError, StationError
-from .gripper import IN_POSITION_TOLERANCE, MOVING_SPEED, Gripper
+from .gripper import Gripper
 from .mechanism import Mechanism, load_mechanism
-from .signals import BOOL, ENUM, FLOAT, INPUT, INT, OUTPUT, SignalSpec
+from .signal_table import IN_POSITION_TOLERANCE, MOVING_SPEED, twin_signals
+from .signals import INPUT, OUTPUT, SignalSpec
 from .station import Station, load_station
 from .world import ROBOT_PREFIX, World, quat
 
-FORCE_UNIT = {"m": "N", "rad": "N*m"}
 
 
 class Device(Protocol):
@@ -47,7 +47,7 @@ class Twin:
         self.station = station
         self.mechanism: Mechanism = load_mechanism(station.gripper.urdf, station.gripper.fingers)
         self.devices: list[Device] = []
-        self._own_signals = self._signal_table()
+        self._own_signals = twin_signals(station, self.mechanism)
         self._index_signals()
         self.world: World | None = None
         self.reset()
@@ -152,74 +152,6 @@ class Twin:
                 device.after_step(self)
 
     # -- signals ------------------------------------------------------------------------------------
-    def _signal_table(self) -> tuple[SignalSpec, ...]:
-        m, st = self.mechanism, self.station
-        targets = tuple(t.name for t in st.targets)
-        sig = [SignalSpec("Active", INPUT, BOOL, description="gripper enable: while low the fingers hold still"
-                          + (" (this station's gripper is always active)" if st.gripper.always_active else ""))]
-        for inp in m.inputs:
-            sig.append(SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max,
-                                  f"setpoint of {inp.type} joint {inp.joint}" + (f" ({inp.note})" if inp.note else "")))
-        sig.append(SignalSpec("doGripped", OUTPUT, BOOL, description="every finger presses on the same target with at least "
-                              "its grip force" + (f" ({st.gripper.grip_force:g})" if st.gripper.grip_force else "")))
-        sig.append(SignalSpec("GrippedPart", OUTPUT, ENUM, description="the held target (none, or one of the target group)",
-                              choices=("",) + targets))
-        sig.append(SignalSpec("slip", OUTPUT, BOOL, description=f"the gripped part moved more than "
-                              f"{st.gripper.slip_distance * 1000:g} mm relative to the gripper's base since it was "
-                              "gripped (held until the next grip)"))
-        for inp in m.inputs:
-            sig.append(SignalSpec(f"{inp.name}.actual", OUTPUT, FLOAT, inp.unit, inp.min, inp.max,
-                                  f"actual position of joint {inp.joint}"))
-            sig.append(SignalSpec(f"{inp.name}.in_position", OUTPUT, BOOL,
-                                  description=f"{inp.name} is within {IN_POSITION_TOLERANCE[inp.unit]:g} {inp.unit} of its setpoint"))
-            sig.append(SignalSpec(f"{inp.name}.moving", OUTPUT, BOOL, description=f"{inp.name} is moving"))
-            limit = self._effort_limit(inp)
-            sig.append(SignalSpec(f"{inp.name}.effort", OUTPUT, FLOAT, FORCE_UNIT[inp.unit], -limit, limit,
-                                  f"force of {inp.name}'s drive, signed along the joint (measured)"))
-        for f in m.fingers:
-            unit = FORCE_UNIT["m" if self._joint_unit(f.joint) == "m" else "rad"]
-            touch = "touches" if st.gripper.grip == "attach" else "touches and presses on"
-            sig.append(SignalSpec(f"{f.name}.contact", OUTPUT, BOOL, description=f"finger {f.name} {touch} a target"))
-            sig.append(SignalSpec(f"{f.name}.force", OUTPUT, FLOAT, unit, 0.0, None,
-                                  f"normal force of finger {f.name} on target objects (measured"
-                                  + (", as torque about its joint)" if unit == "N*m" else ")")))
-            sig.append(SignalSpec(f"{f.name}.status", OUTPUT, INT, "", 0, 3,
-                                  f"finger {f.name}'s object status: 0 moving, 1 stopped by contact while opening, "
-                                  "2 stopped by contact while closing, 3 at the setpoint"))
-        if st.robot is not None:
-            sig.append(SignalSpec("robot.busy", OUTPUT, BOOL, group="robot", description="the robot is executing a motion"))
-            for i, _ in enumerate(st.robot.joints, start=1):
-                sig.append(SignalSpec(f"robot.j{i}", OUTPUT, FLOAT, "rad", group="robot", description=f"robot axis {i} position"))
-        for t in st.targets:
-            sig.append(SignalSpec(f"{t.name}.present", INPUT, BOOL, group="cell",
-                                  description=f"{t.name} is in the cell: write 0 to take it away (a missing part), "
-                                              "1 to put it back where the station places it"))
-            for axis in "xyz":
-                sig.append(SignalSpec(f"{t.name}.{axis}", OUTPUT, FLOAT, "m", group="cell",
-                                      description=f"{axis} of {t.name}'s centre in the world frame"))
-        seen: dict[str, SignalSpec] = {}
-        for spec in sig:  # link and target names are free text: two of them may make the same signal name
-            if spec.name in seen:
-                raise StationError(str(st.file), "gripper.urdf", f"two signals would be named {spec.name!r} "
-                                   f"({seen[spec.name].description}; {spec.description}): rename a link or target")
-            seen[spec.name] = spec
-        return tuple(sig)
-
-    def _effort_limit(self, inp) -> float:
-        from .gripper import DEFAULT_EFFORT
-
-        o = self.station.gripper.joints.get(inp.name)
-        return (o.effort if o and o.effort else None) or inp.effort or DEFAULT_EFFORT[inp.unit]
-
-    def _joint_unit(self, joint: str) -> str:
-        for inp in self.mechanism.inputs:
-            if inp.joint == joint:
-                return inp.unit
-        for mim in self.mechanism.mimics:
-            if mim.joint == joint:
-                return self._joint_unit(mim.master)
-        return "m"
-
     def spec(self, name: str) -> SignalSpec:
         try:
             return self._spec[name]
@@ -241,21 +173,18 @@ class Twin:
         return self._outputs[name]
 
     def write(self, name: str, value) -> None:
-        """Write an input. Takes effect at the next step. Out of range: SignalRangeError, nothing changes."""
-        spec = self.spec(name)
-        if spec.direction != INPUT:
-            raise SignalError(name, "is an output of the twin and cannot be written")
+        """Write an input. Takes effect at the next step. Checked by `SignalSpec.check` (SignalError for an
+        output, SignalTypeError for a wrong type, SignalRangeError out of range): on error nothing changes."""
+        value = self.spec(name).check(value)
         device = self._owner[name]
         if device is not None:
             device.write(name, value)
         elif name in self._present:
-            self._present[name] = bool(value)
-        elif spec.type == BOOL:
-            self.gripper.set_active(bool(value))
+            self._present[name] = value
+        elif name == "Active":
+            self.gripper.set_active(value)
         else:
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-                raise SignalError(name, f"needs a number, not {value!r}")
-            self.gripper.set_setpoint(name, float(value))
+            self.gripper.set_setpoint(name, value)
 
     def set_drive_limits(self, name: str, velocity: float | None = None, effort: float | None = None) -> None:
         """Change input `name`'s velocity limit (m/s or rad/s) or effort limit (N or N*m) from the next step on

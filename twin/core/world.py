@@ -26,7 +26,7 @@ from pybullet_utils.bullet_client import BulletClient
 from .errors import StationError
 from .mechanism import NOT_DRIVEN
 from .station import Body, Placement, Station
-from ..native_output import quiet_native_output
+from .native_output import quiet_native_output
 
 ROBOT_PREFIX = "robot/"
 COLLISION_MARGIN = 0.0001  # m: pybullet's default 1 mm margin rounds box corners (contact 0.4-0.7 mm late)

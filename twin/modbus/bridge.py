@@ -1,80 +1,93 @@
-"""The bridge between a twin and the register map: register images out, queued writes in.
+"""The Modbus front end of a cell: register images from the cell's snapshots, writes into its exchange.
 
-`TwinBridge.step()` is what a runner (`twin.pacing`) calls once per simulation step: it applies the
-writes queued since the last step (each request's writes together, in arrival order), steps the twin
-once, and publishes new register images. The server only ever reads published images, so a read of an
-output sees the state after the last completed step, and a write takes effect at the next step.
+`TwinBridge(exchange, rmap)` follows the front-end contract of `twin.exchange`: it subscribes to the
+exchange and turns each published snapshot into four register images (coils, discrete inputs, holding
+registers, input registers), which the server (`twin.modbus.server`) answers reads from. A write request
+becomes one batch of (signal, SI value) for `exchange.submit`: it is validated there like any front end's
+write (an error answers exception 03, a faulted simulation 04) and takes effect at the next step.
 
-Inputs (coils, holding registers) are what the client wrote: an accepted write is copied into their
-images at once (`_show_written`), so reading it back gives the written value before the step applies
-it. A step's publish cannot undo that: the runner and the server share one event loop, so no write
-arrives between a step taking the queue and its publish, and every write queued before the step has
-been applied to the twin by then. `publish` still lays the writes still queued over what it reads
-from the twin, so the rule does not depend on who calls it when.
-
-The twin is anything with `signals`, `read(name)`, `write(name, value)`, `step()`, `step_count`,
-`time` and `dt` (the `twin.core.Twin` contract). The bridge imports neither sockets nor clocks.
+Inputs (coils, holding registers) are what a client wrote: an accepted write (from this or any other
+front end) is copied into their images at once (`_show_written`), so reading it back gives the written
+value before the step applies it. A publish lays the writes still queued over the snapshot, so no step
+can undo that.
 """
 from __future__ import annotations
 
 import dataclasses
 import struct
-import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
-from .log import log as _log
-from .register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, FAULT, HOLDING_REGISTER,
-                           INPUT_REGISTER, LATE, LATE_STEPS, LOCKSTEP, MAP_CRC, MODE, SPEED_PCT, STEP, TIME_MS,
-                           Entry, RegisterMap, map_crc)
+from twin.core.errors import SignalError, TwinError
+from twin.exchange import Exchange, SimulationFault, Snapshot
+
+from .register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, MAP_CRC,
+                           Entry, RegisterMap)
 from .pdu import ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE, Images
 
 
 class TwinBridge:
-    """Publishes a twin's signals as register images and queues writes for the next step."""
+    """Publishes an exchange's snapshots as register images and submits writes to it."""
 
-    def __init__(self, twin, rmap: RegisterMap, *, log: Callable[[str], None] = _log):
-        self.twin, self.map, self.log = twin, rmap, log
-        self.runner = None  # set by whoever paces the twin (twin.pacing): mode, speed, late_steps, remaining
-        self.fault = False
-        self._encoded: dict[int, tuple[object, list[int]]] = {}  # id(entry): the map outlives it
-        self.extra_status: dict[str, object] = {}  # values of sim.* entries the server's owner knows (comm.watchdog_ms)
-        self._queue: list[Sequence[tuple[Entry, object]]] = []
+    def __init__(self, exchange: Exchange, rmap: RegisterMap):
+        self.exchange, self.map = exchange, rmap
         self._sizes = {t: rmap.size(t) for t in (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)}
-        self._entries = {t: rmap.table(t) for t in self._sizes}
+        self._keyed = {t: [(e, e.signal or e.name) for e in rmap.table(t)] for t in self._sizes}  # entry, value key
+        self._by_signal = {e.signal or e.name: e for e in rmap}
         self._advance = rmap[ADVANCE] if ADVANCE in rmap else None
         self.live_addresses = frozenset({self._advance.address} if self._advance is not None else ())
-        self.crc = map_crc(rmap)  # published in sim.map_crc: the client checks it holds this map
+        self.crc = rmap.crc  # sim.map_crc: the CRC of the map this front end serves
+        self._encoded: dict[int, tuple[object, list[int]]] = {}  # id(entry): the map outlives it
         self.images: Images = Images(b"", b"", b"", b"")
-        self.publish()
+        self.publish(exchange.snapshot)
+        self._unsubscribe = exchange.subscribe(on_snapshot=self.publish, on_writes=self._show_written)
+
+    def close(self) -> None:
+        self._unsubscribe()
+
+    @property
+    def fault(self) -> bool:
+        """The simulation stopped on an error (writes get exception 04)."""
+        return self.exchange.fault
 
     # -- the server's side ----------------------------------------------------------------------------
     def submit(self, changes: Sequence[tuple[Entry, object]]) -> int:
-        if self.fault:
+        """One request's writes: 0 when queued, else the Modbus exception code (nothing queued)."""
+        try:
+            self.exchange.submit([(entry.signal or entry.name, value) for entry, value in changes])
+        except SimulationFault:
             return SERVER_DEVICE_FAILURE
-        signals = []
-        for entry, value in changes:
-            if entry.name == ADVANCE:
-                n = int(value)
-                runner = self.runner
-                if runner is None or runner.mode != "lockstep":
-                    if n != 0:
-                        return ILLEGAL_DATA_VALUE
-                elif runner.remaining + n > 0xFFFF:
-                    return ILLEGAL_DATA_VALUE
-            elif entry.signal is not None:
-                signals.append((entry, value))
-        for entry, value in changes:  # checked: now act
-            if entry.name == ADVANCE and int(value) and self.runner is not None and self.runner.mode == "lockstep":
-                self.runner.request(int(value))
-        if signals:
-            self._queue.append(signals)
-            self._show_written(signals)
+        except SignalError:
+            return ILLEGAL_DATA_VALUE
+        except TwinError:
+            return SERVER_DEVICE_FAILURE
         return 0
 
-    def _show_written(self, changes: Sequence[tuple[Entry, object]]) -> None:
+    def stepping(self) -> bool:
+        """Lockstep steps asked for are still to run."""
+        runner = self.exchange.runner
+        return runner is not None and runner.mode == "lockstep" and runner.remaining > 0
+
+    def when_stepped(self, callback) -> None:
+        """Call `callback()` once the lockstep steps asked for are done (at once when none are left)."""
+        if not self.stepping() or self.fault:
+            callback()
+        else:
+            self.exchange.runner.when_done(callback)
+
+    def live_holding(self, address: int) -> int | None:
+        if self._advance is not None and address == self._advance.address:
+            runner = self.exchange.runner
+            return 0 if runner is None else min(0xFFFF, runner.remaining)
+        return None
+
+    # -- the exchange's side --------------------------------------------------------------------------
+    def _show_written(self, batch: Sequence[tuple[str, object]]) -> None:
         """Copy accepted writes into the coil and holding-register images (as the next publish will show them)."""
         coils = holding = None
-        for entry, value in changes:
+        for name, value in batch:
+            entry = self._by_signal.get(name)
+            if entry is None:
+                continue
             if entry.table == COIL:
                 if coils is None:
                     coils = bytearray(self.images.coils)
@@ -91,74 +104,28 @@ class TwinBridge:
         if changed:
             self.images = dataclasses.replace(self.images, **changed)
 
-    def stepping(self) -> bool:
-        runner = self.runner
-        return runner is not None and runner.mode == "lockstep" and runner.remaining > 0
-
-    def when_stepped(self, callback) -> None:
-        if not self.stepping() or self.fault:
-            callback()
-        else:
-            self.runner.when_done(callback)
-
-    def live_holding(self, address: int) -> int | None:
-        if self._advance is not None and address == self._advance.address:
-            return 0 if self.runner is None else min(0xFFFF, self.runner.remaining)
-        return None
-
-    # -- the runner's side ----------------------------------------------------------------------------
-    def step(self) -> bool:
-        """Apply queued writes, run one step, publish. False (and the fault bit) if the twin failed."""
-        if self.fault:
-            return False
-        queue, self._queue = self._queue, []
-        try:
-            for batch in queue:
-                for entry, value in batch:
-                    self.twin.write(entry.signal, value)
-            self.twin.step()
-        except Exception as exc:  # a physics or device error: keep serving the last state, flag it
-            self.fault = True
-            self.log(f"simulation fault at step {self.twin.step_count}: {type(exc).__name__}: {exc}\n"
-                     + traceback.format_exc().rstrip())
-            self.publish()
-            return False
-        self.publish()
-        return True
-
-    def _status(self) -> dict:
-        twin, runner = self.twin, self.runner
-        lockstep = runner is not None and runner.mode == "lockstep"
-        return {
-            FAULT: self.fault, LOCKSTEP: lockstep, LATE: bool(runner is not None and runner.last_late),
-            STEP: twin.step_count, TIME_MS: round(twin.time * 1000), DT_US: round(twin.dt * 1e6),
-            LATE_STEPS: 0 if runner is None else runner.late_steps, MODE: 0 if lockstep else 1,
-            SPEED_PCT: 0 if runner is None or lockstep else round(runner.speed * 100), ADVANCE: 0,
-            MAP_CRC: self.crc, **self.extra_status,
-        }
-
-    def publish(self) -> None:
-        status = self._status()
-        read = self.twin.read
+    def publish(self, snapshot: Snapshot | None = None) -> None:
+        """New images from a snapshot (default: the exchange's latest), with the writes still queued on top."""
+        values = (snapshot or self.exchange.snapshot).values
+        crc = self.crc
         images = {}
-        for table, entries in self._entries.items():
+        for table, entries in self._keyed.items():
             size = self._sizes[table]
             if table in BIT_TABLES:
                 img = bytearray(size)
-                for e in entries:
-                    v = read(e.signal) if e.signal is not None else status.get(e.name, 0)
-                    img[e.address] = 1 if v else 0
+                for e, key in entries:
+                    img[e.address] = 1 if values.get(key, 0) else 0
                 images[table] = bytes(img)
             else:
                 words = [0] * size
                 encoded = self._encoded  # entry -> (value, words): most values do not change from step to step
-                for e in entries:
-                    v = read(e.signal) if e.signal is not None else status.get(e.name, 0)
+                for e, key in entries:
+                    v = crc if key == MAP_CRC else values.get(key, 0)
                     last = encoded.get(id(e))
                     if last is None or last[0] != v or type(last[0]) is not type(v):
                         last = encoded[id(e)] = (v, e.encode(v))
                     words[e.address:e.end] = last[1]
                 images[table] = struct.pack(f">{size}H", *words)
         self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
-        for batch in self._queue:  # written but not yet applied (empty after a step): still reads as written
+        for batch in self.exchange.pending:  # written but not yet applied (empty after a step): still reads as written
             self._show_written(batch)

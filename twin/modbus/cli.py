@@ -1,4 +1,5 @@
-"""The `twin serve` and `twin map` subcommands (added to the `twin` command by `add_commands`).
+"""The Modbus side of `twin serve` and `twin map` (added to the `twin` command by `add_commands`; the
+application, `twin_app.cli`, runs `serve`: it assembles the cell and plugs `front_end.ModbusFrontEnd` in).
 
     twin serve STATION [--host 127.0.0.1] [--port 5020] [--unit-id 1] [--realtime | --lockstep] [--speed X]
                        [--log-level info] [--max-connections 64] [--idle-timeout S] [--requests-per-step 400]
@@ -15,34 +16,13 @@ loading stops it once it is loaded. What each option does next to a real network
 from __future__ import annotations
 
 import argparse
-import asyncio
-import signal
 import logging
 import sys
 from pathlib import Path
 
-from .log import LEVELS, announce, log as _log
+from .log import LEVELS, log as _log
 
 MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT = 64, 400, 802  # as twin.modbus.server (not imported: start-up speed)
-
-
-def open_twin(station, on_event=None):
-    """The cell `serve` runs for a station (the same one `map` describes, so both agree): the twin and,
-    when the station has a `[controller]`, its RAPID program as the robot controller."""
-    from twin.cell import open_cell
-
-    return open_cell(Path(station), on_event=on_event)
-
-
-def controller_log(event: dict) -> None:
-    """What the robot controller says, in the server's log: TPWrite lines, a runtime error, the end."""
-    kind, t = event.get("type"), event.get("t", 0.0)
-    if kind == "print":
-        _log(f"[t={t:.3f} s] robot: {event['text']}")
-    elif kind == "error":
-        _log(f"[t={t:.3f} s] robot program error at line {event['line']}: {event['message']}")
-    elif kind == "end":
-        _log(f"[t={t:.3f} s] robot program ended ({event['reason']})")
 
 
 def _positive(text: str) -> float:
@@ -89,10 +69,27 @@ def _networks(text: str):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def add_commands(subparsers) -> None:
+def add_commands(subparsers, cmd_serve):
+    """`twin serve` (run by `cmd_serve`, the application's: it assembles the cell) and `twin map`. Returns the
+    `serve` parser, for the other front ends' flags."""
     p = subparsers.add_parser("serve", help="serve a station's signals on Modbus/TCP",
                               description="Run a station and serve every signal on Modbus/TCP (map: `twin map`).")
     p.add_argument("station", help="a station folder or station.toml")
+    add_serve_arguments(p)
+    p.set_defaults(func=cmd_serve, lockstep=False)
+    serve = p
+
+    p = subparsers.add_parser("map", help="print the Modbus register map of a station",
+                              description="Print the register map `twin serve` serves for a station (from the station's "
+                                          "files: no physics, no robot program).")
+    p.add_argument("station", help="a station folder or station.toml")
+    p.add_argument("--format", choices=("json", "csv", "md"), default="md", help="output format (default md)")
+    p.set_defaults(func=cmd_map)
+    return serve
+
+
+def add_serve_arguments(p) -> None:
+    """The Modbus front end's flags of `twin serve` (and the runner's: --realtime/--lockstep, --speed)."""
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback only)")
     p.add_argument("--port", type=_port, default=5020, help="TCP port (default 5020; 0 = any free port, printed)")
     p.add_argument("--unit-id", type=_unit, default=None,
@@ -130,25 +127,12 @@ def add_commands(subparsers) -> None:
     g.add_argument("--tls-port", type=_port, default=TLS_PORT, help=f"the TLS port (default {TLS_PORT}; 0 = any free)")
     g.add_argument("--tls-only", action="store_true", help="with TLS: do not listen on plain Modbus/TCP (--port)")
     _add_profile_arguments(p)
-    from twin.view.live import add_serve_options  # --view [PORT], --record FILE (twin.view, twin.recording)
-
-    add_serve_options(p)
-    from twin.opcua.serve import add_arguments as add_opcua_arguments  # --opcua [PORT], --no-modbus, --opcua-*
-
-    add_opcua_arguments(p)
-    p.set_defaults(func=cmd_serve, lockstep=False)
-
-    p = subparsers.add_parser("map", help="print the Modbus register map of a station",
-                              description="Print the register map `twin serve` serves for a station.")
-    p.add_argument("station", help="a station folder or station.toml")
-    p.add_argument("--format", choices=("json", "csv", "md"), default="md", help="output format (default md)")
-    p.set_defaults(func=cmd_map)
 
 
 def _add_profile_arguments(p) -> None:
     from twin.profiles.robotiq import PROFILES
 
-    from .profile import MAP_UNIT_ID
+    from .register_map import MAP_UNIT_ID
 
     g = p.add_argument_group("device profiles (see twin/modbus/README.md, Device profiles)")
     g.add_argument("--profile", choices=PROFILES, default=None,
@@ -169,119 +153,7 @@ def cmd_map(args) -> int:
     return 0
 
 
-class StopRequested(BaseException):
-    """A second SIGINT or SIGTERM while the station is loading: cut the loading short. A BaseException,
-    so that no `except Exception` on the way out of the loaders swallows it."""
-
-
-class _StartUpSignals:
-    """SIGINT/SIGTERM before the event loop takes them over (loading the station takes a while).
-
-    The first one is remembered (and sets `stop`): the server stops cleanly as soon as the station is
-    loaded. It does not raise, for an exception raised there lands in whatever is loading: numpy's
-    import turns it into an ImportError, which pybullet prints. A second one cuts the loading short
-    (StopRequested). Once stopping, signals are ignored, so none can interrupt the shutdown."""
-
-    SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-    def __init__(self, stop: asyncio.Event):
-        self.stop = stop
-        self.received: int | None = None
-        self.stopping = False
-        self.previous = {}
-        try:
-            for sig in self.SIGNALS:
-                self.previous[sig] = signal.signal(sig, self._on_signal)
-        except ValueError:  # not the main thread: signals are the caller's business
-            pass
-
-    def _on_signal(self, signum, frame) -> None:
-        if self.stopping:
-            return
-        if self.received is None:
-            self.received = signum
-            self.stop.set()
-            return
-        self.stopping = True
-        raise StopRequested(signum)
-
-    def ignore(self) -> None:
-        """Stopping: the event loop has put back the default handlers; take the signals again."""
-        self.stopping = True
-        for sig in self.previous:
-            signal.signal(sig, self._on_signal)
-
-    def restore(self) -> None:
-        for sig, handler in self.previous.items():
-            signal.signal(sig, handler)
-
-
-def cmd_serve(args) -> int:
-    from . import log as serve_log
-
-    serve_log.setup(args.log_level)
-    from twin.opcua.serve import check_arguments as check_opcua_arguments
-
-    if (problem := check_opcua_arguments(args)) is not None:
-        print(f"twin serve: error: {problem}", file=sys.stderr)
-        return 2
-    stop = asyncio.Event()
-    signals = _StartUpSignals(stop)  # first thing: loading the station (pybullet) takes a while
-    twin = None
-    try:
-        tls = _tls_from(args)
-        if isinstance(tls, int):
-            return tls
-        from .register_map import build_register_map
-
-        if args.profile and args.unit_id is not None and args.unit_id == args.map_unit_id:
-            _log(f"error: --unit-id {args.unit_id} is also the --map-unit-id: give them different unit ids", logging.ERROR)
-            return 2
-        announce(f"loading station {args.station}")
-        twin = open_twin(args.station, on_event=controller_log)
-        if getattr(args, "faults", None):
-            from twin.campaign.faultfile import load_fault_file
-            from twin.campaign.spec import SpecError
-            from twin.faults import FaultInjector
-
-            try:
-                FaultInjector.attach(twin, load_fault_file(args.faults, twin))
-            except SpecError as exc:
-                _log(f"error: --faults: {exc}", logging.ERROR)
-                return 2
-        rmap = build_register_map(twin.signals, twin.station.name)
-        profile = None
-        if args.profile:
-            from twin.core.errors import StationError
-            from twin.profiles.robotiq import open_profile
-
-            try:
-                profile = open_profile(twin, args.profile)
-            except StationError as exc:
-                _log(f"error: --profile {args.profile}: {exc}", logging.ERROR)
-                return 2
-        if signals.received is not None:
-            raise StopRequested(signals.received)
-        return asyncio.run(serve(twin, rmap, host=args.host, port=args.port,
-                                 unit_id=1 if args.unit_id is None else args.unit_id,
-                                 lockstep=args.lockstep, speed=args.speed, frame_timeout=args.frame_timeout, stop=stop,
-                                 options=args, tls=tls, profile=profile))
-    except BaseException:
-        if signals.received is None:
-            raise
-        announce(f"stopped by {signal.Signals(signals.received).name} while starting")
-        return 0
-    finally:
-        signals.ignore()
-        try:
-            if twin is not None:
-                twin.close()
-        finally:
-            signals.restore()
-            serve_log.flush()
-
-
-def _tls_from(args):
+def tls_from_args(args):
     """The TLS context from --tls-cert/--tls-key/--tls-ca, None without them, or exit status 2 (logged)."""
     given = {k: getattr(args, k, None) for k in ("tls_cert", "tls_key", "tls_ca")}
     if not any(given.values()):
@@ -310,7 +182,7 @@ def _tls_from(args):
         return 2
 
 
-def device_identity(twin, rmap):
+def device_identity(station, rmap):
     """What function 43/14 answers: vendor, product code, version, the station's name."""
     from importlib import metadata
 
@@ -320,127 +192,10 @@ def device_identity(twin, rmap):
         version = metadata.version("gripper-twin")
     except metadata.PackageNotFoundError:
         version = "0.1.0"
-    name = twin.station.name
+    name = station.name
     return DeviceIdentity(vendor="gripper-twin", product_code="GT-TWIN-SERVE", revision=version,
                           product_name="gripper-twin Modbus/TCP server", model_name="twin serve",
                           user_application_name=name,
                           extended={STATION_NAME_OBJECT: name, MAP_CRC_OBJECT: f"{rmap.crc:08x}"})
 
 
-async def serve(twin, rmap, *, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1, lockstep: bool = False,
-                speed: float = 1.0, frame_timeout: float = 1.0, stop: asyncio.Event | None = None,
-                options=None, tls=None, profile=None) -> int:
-    """Serve `twin` with `rmap` until `stop` is set (or SIGINT/SIGTERM). Returns the exit code.
-    `options`: the parsed `twin serve` flags (limits, access, watchdog); `tls`: an ssl.SSLContext.
-    `profile`: a device profile's gripper (`twin.profiles.robotiq.open_profile`): it answers on `options.unit_id`
-    if given, else on every unit id but `options.map_unit_id`, which keeps `rmap` (see `twin.modbus.profile`)."""
-    from twin.pacing import LockstepRunner, RealtimeRunner
-
-    from .bridge import TwinBridge
-    from .server import ModbusServer
-
-    opt = options
-    get = (lambda name, default: getattr(opt, name, default)) if opt is not None else (lambda name, default: default)
-    loop = asyncio.get_running_loop()
-    loop.set_exception_handler(lambda _loop, ctx: _log(f"event loop: {ctx.get('message')}: "
-                                                       f"{ctx.get('exception')!r}", logging.DEBUG))
-    stop = stop or asyncio.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        try:
-            loop.add_signal_handler(sig, stop.set)
-        except (NotImplementedError, RuntimeError, ValueError):  # not the main thread, or Windows
-            pass
-    bridge = TwinBridge(twin, rmap)
-    opcua = None
-    if get("opcua", None) is not None:  # OPC UA on the same cell: the bridge's step, then its publication
-        from twin.opcua.cell_link import CellLink
-
-        opcua = CellLink(twin, bridge)
-    step = opcua.step if opcua is not None else bridge.step
-    runner = LockstepRunner(step) if lockstep else RealtimeRunner(step, twin.dt, speed)
-    bridge.runner = runner
-    watchdog = getattr(twin, "watchdog", None)
-    on_request = None
-    if watchdog is not None:
-        timeout = get("watchdog", None)
-        if timeout is not None:
-            watchdog.timeout = timeout or None
-        watchdog.log = lambda text: _log(text, logging.WARNING)
-        if not lockstep:
-            watchdog.clock = runner.clock  # real time: the wall clock; lockstep: simulated time
-        bridge.extra_status["comm.watchdog_ms"] = round((watchdog.timeout or 0) * 1000)
-        on_request = lambda peer, clock_only: watchdog.feed(f"modbus {peer}", clock_only=lockstep and clock_only)  # noqa: E731
-    bridge.publish()
-    server = ModbusServer(rmap, bridge, unit_id=unit_id, frame_timeout=frame_timeout,
-                          requests_per_step=get("requests_per_step", REQUESTS_PER_STEP),
-                          step_period=twin.dt / (speed if not lockstep else 1.0),
-                          max_connections=get("max_connections", MAX_CONNECTIONS),
-                          idle_timeout=get("idle_timeout", 0.0) or None, allow=get("allow", None),
-                          read_only=get("read_only", False), gaps_zero=get("gaps", "error") == "zero",
-                          identity=device_identity(twin, rmap), on_request=on_request,
-                          behind=(lambda: runner.last_late) if not lockstep else None)
-    if profile is not None:
-        from .profile import MAP_UNIT_ID, serve_profile
-
-        profile_unit = get("unit_id", None)
-        unit_id = get("map_unit_id", MAP_UNIT_ID)
-        serve_profile(server, profile, bridge, unit_id=profile_unit, map_unit_id=unit_id)
-    listening = []
-    try:
-        if not get("tls_only", False) and not get("no_modbus", False):
-            listening.append(("", *await server.start(host, port)))
-        if tls is not None:
-            tls_port = get("tls_port", TLS_PORT)
-            port = tls_port
-            listening.append((" (Modbus/TCP Security, TLS)", *await server.start(host, tls_port, ssl=tls)))
-    except OSError as exc:
-        _log(f"error: cannot listen on {host}:{port}: {exc.strerror or exc}", logging.ERROR)
-        await server.close()
-        return 2
-    how = "lockstep (steps on sim.advance)" if lockstep else f"real time x{speed:g}"
-    notes = [f"{len(rmap)} entries", f"unit {unit_id}", how, f"step {twin.dt * 1000:g} ms"]
-    if get("read_only", False):
-        notes.append("read-only")
-    if watchdog is not None and watchdog.timeout:
-        notes.append(f"watchdog {watchdog.timeout:g} s ({watchdog.safe_state})")
-    announce(f"station {twin.station.name!r}: " + ", ".join(notes))
-    if profile is not None:
-        where = f"unit {profile_unit}" if profile_unit is not None else f"every unit id but {unit_id}"
-        announce(f"profile {profile.kind} on {where}")
-    for what, bound_host, bound_port in listening:
-        announce(f"listening on {bound_host}:{bound_port}{what}")
-    from twin.view.live import serve_front_ends  # --view, --record: the page and the recorder
-
-    start_front_ends = serve_front_ends(opt)
-    stop_front_ends = start_front_ends(twin, bridge, runner, rmap) if start_front_ends is not None else None
-    ua_server = None
-    if opcua is not None:
-        from twin.opcua.serve import options_from, start_opcua_logged
-
-        opcua.runner = runner
-        ua_server = await start_opcua_logged(opcua, **options_from(opt))
-        if ua_server is None:
-            if stop_front_ends is not None:
-                stop_front_ends()
-            await server.close()
-            return 2
-    task = asyncio.ensure_future(runner.run())
-    stopper = asyncio.ensure_future(stop.wait())
-    await asyncio.wait({task, stopper}, return_when=asyncio.FIRST_COMPLETED)
-    if task.done() and task.exception() is not None:
-        _log(f"error: the runner failed: {task.exception()!r}", logging.ERROR)
-    if task.done() and not stop.is_set():
-        await stop.wait()  # faulted: keep serving the last state until stopped
-    runner.stop()
-    await server.close()
-    if stop_front_ends is not None:
-        stop_front_ends()
-    if ua_server is not None:
-        await ua_server.close()
-    for t in (task, stopper):
-        if not t.done():
-            t.cancel()
-    await asyncio.gather(task, stopper, return_exceptions=True)
-    late = f", {runner.late_steps} late" if not lockstep else ""
-    announce(f"stopped after {twin.step_count} steps ({twin.time:.3f} s simulated{late}, {server.requests} requests)")
-    return 0

@@ -24,14 +24,13 @@ gripper talks to the profile unchanged, a test harness steps the simulation thro
 from __future__ import annotations
 
 from .pdu import SERVER_DEVICE_FAILURE, Images, PduHandler
-from .register_map import HOLDING_REGISTER, INPUT_REGISTER, Entry, RegisterMap
+from .register_map import HOLDING_REGISTER, INPUT_REGISTER, MAP_UNIT_ID, Entry, RegisterMap
 from .server import ModbusServer
 
 REGISTERS = 8  # 16 bytes
 OUTPUT_ADDRESSES = (0x0000, 0x03E8)  # robot output (holding registers, read/write)
 STATUS_ADDRESSES = (0x0000, 0x07D0)  # robot input (input registers)
 STATUS_HOLDING = 0x07D0  # the robot input again as read-only holding registers (FC 3, FC 23's read)
-MAP_UNIT_ID = 247  # the generated map's unit id while a profile is served
 
 
 def profile_register_map(kind: str) -> RegisterMap:

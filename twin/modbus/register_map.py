@@ -48,12 +48,18 @@ import zlib
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 
+from twin.core.signal_table import (SIM_ADVANCE as ADVANCE, SIM_DT_US as DT_US, SIM_FAULT as FAULT,
+                                    SIM_LATE as LATE, SIM_LATE_STEPS as LATE_STEPS, SIM_LOCKSTEP as LOCKSTEP,
+                                    SIM_MAP_CRC as MAP_CRC, SIM_MODE as MODE, SIM_SIGNALS, SIM_SPEED_PCT as SPEED_PCT,
+                                    SIM_STEP as STEP, SIM_TIME_MS as TIME_MS, WATCHDOG_MS, station_signals)
 from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
+from twin.core.station import load_station
 
 COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER = "coil", "discrete_input", "holding_register", "input_register"
 TABLES = (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)
 BIT_TABLES = (COIL, DISCRETE_INPUT)
 RESERVED = 16  # addresses 0..15 of every table belong to the twin (sim.* and fault)
+MAP_UNIT_ID = 247  # the generated map's unit id while a device profile is served (twin.modbus.profile)
 
 # Conventional 1-based "Modicon" references, for the printed map.
 REFERENCE_BASE = {COIL: 1, DISCRETE_INPUT: 10001, INPUT_REGISTER: 30001, HOLDING_REGISTER: 40001}
@@ -71,12 +77,6 @@ UNITS = {
     "N*m": ("N*m", 1.0, 0.01),
 }
 
-# The twin's own registers (fixed addresses inside the reserved block).
-ADVANCE, STEP, TIME_MS, LATE_STEPS, DT_US, MODE, SPEED_PCT, MAP_CRC = (
-    "sim.advance", "sim.step", "sim.time_ms", "sim.late_steps", "sim.dt_us", "sim.mode", "sim.speed_pct",
-    "sim.map_crc")
-FAULT, LOCKSTEP, LATE = "fault", "sim.lockstep", "sim.late"
-WATCHDOG_MS = "comm.watchdog_ms"
 
 
 class MapError(ValueError):
@@ -329,34 +329,25 @@ def _range(e: Entry) -> str:
 
 
 # -- building ------------------------------------------------------------------------------------------
+# Where the simulator's own signals (`twin.core.signal_table.SIM_SIGNALS`) sit in the reserved block.
+SIM_PLACES = {
+    ADVANCE: (HOLDING_REGISTER, 0, "uint16"),
+    FAULT: (DISCRETE_INPUT, 0, "bool"), LOCKSTEP: (DISCRETE_INPUT, 1, "bool"), LATE: (DISCRETE_INPUT, 2, "bool"),
+    STEP: (INPUT_REGISTER, 0, "uint32"), TIME_MS: (INPUT_REGISTER, 2, "uint32"), LATE_STEPS: (INPUT_REGISTER, 4, "uint32"),
+    DT_US: (INPUT_REGISTER, 6, "uint16"), MODE: (INPUT_REGISTER, 7, "uint16"), SPEED_PCT: (INPUT_REGISTER, 8, "uint16"),
+    MAP_CRC: (INPUT_REGISTER, 10, "uint32"), WATCHDOG_MS: (INPUT_REGISTER, 12, "uint32"),
+}
+# What the protocol adds to a sim signal's description (the Modbus answer to a refused write).
+SIM_NOTES = {ADVANCE: " (else exception 03)", FAULT: ", writes get exception 04"}
+
+
 def _sim_entries() -> list[Entry]:
-    u32 = (0, float(0xFFFFFFFF))
-    E = Entry
-    return [
-        E(ADVANCE, HOLDING_REGISTER, 0, 1, "uint16", 1.0, "steps", 0, 65535, "rw",
-          "lockstep: write N to run N more steps; reads the steps still to run (0 when done). "
-          "Real time: reads 0 and only 0 may be written (else exception 03)"),
-        E(FAULT, DISCRETE_INPUT, 0, 1, "bool", 1.0, "", None, None, "r",
-          "the simulation stopped on an error (see the server's log); outputs are frozen, writes get exception 04"),
-        E(LOCKSTEP, DISCRETE_INPUT, 1, 1, "bool", 1.0, "", None, None, "r",
-          "the server runs in lockstep (steps only through sim.advance)"),
-        E(LATE, DISCRETE_INPUT, 2, 1, "bool", 1.0, "", None, None, "r",
-          "real time: the last step finished after its wall-clock deadline"),
-        E(STEP, INPUT_REGISTER, 0, 2, "uint32", 1.0, "steps", *u32, "r", "simulation steps completed"),
-        E(TIME_MS, INPUT_REGISTER, 2, 2, "uint32", 1.0, "ms", *u32, "r", "simulated time (steps x step length)"),
-        E(LATE_STEPS, INPUT_REGISTER, 4, 2, "uint32", 1.0, "steps", *u32, "r",
-          "real time: steps that finished after their wall-clock deadline"),
-        E(DT_US, INPUT_REGISTER, 6, 1, "uint16", 1.0, "us", 0, 65535, "r", "simulation step length"),
-        E(MODE, INPUT_REGISTER, 7, 1, "uint16", 1.0, "", 0, 1, "r", "0 = lockstep, 1 = real time"),
-        E(SPEED_PCT, INPUT_REGISTER, 8, 1, "uint16", 1.0, "%", 0, 65535, "r",
-          "real time: speed in percent of real time (100 = real time); 0 in lockstep"),
-        E(MAP_CRC, INPUT_REGISTER, 10, 2, "uint32", 1.0, "", *u32, "r",
-          "CRC-32 of this register map (name, table, address, count, type and scale of every other entry): "
-          "a client compares it with the CRC of the map it was given"),
-        E(WATCHDOG_MS, INPUT_REGISTER, 12, 2, "uint32", 1.0, "ms", *u32, "r",
-          "the comm-loss watchdog's time (0: off): a client sends a request at least this often (a heartbeat), "
-          "else comm.lost rises and the gripper goes to the station's safe state"),
-    ]
+    entries = []
+    for s in SIM_SIGNALS:
+        table, address, type_ = SIM_PLACES[s.name]
+        entries.append(Entry(s.name, table, address, WIDTH[type_], type_, 1.0, s.unit, s.min, s.max,
+                             "rw" if s.direction == INPUT else "r", s.description + SIM_NOTES.get(s.name, "")))
+    return entries
 
 
 def _fit_type(lo_e: float | None, hi_e: float | None, scale: float, signed_default: bool) -> str:
@@ -400,6 +391,8 @@ def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> Regi
     seen = {e.name for e in entries}
     nxt = {t: RESERVED for t in TABLES}
     for s in signals:
+        if s in SIM_SIGNALS:  # the simulator's own: placed above, at their fixed addresses
+            continue
         if s.name in seen:
             raise MapError(f"signal {s.name!r} appears twice (or clashes with the simulator's own entry)")
         seen.add(s.name)
@@ -420,11 +413,7 @@ def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> Regi
 
 
 def build_map(station) -> RegisterMap:
-    """The map `twin serve` serves for a station (a folder or a station.toml): builds its twin."""
-    from .cli import open_twin
-
-    twin = open_twin(station)
-    try:
-        return build_register_map(twin.signals, twin.station.name)
-    finally:
-        twin.close()
+    """The map `twin serve` serves for a station (a folder or a station.toml), from its static signal table:
+    no physics, no RAPID (a wrong station raises the core's StationError)."""
+    st = load_station(station)
+    return build_register_map(station_signals(st), st.name)

@@ -85,7 +85,7 @@ def check_arguments(args) -> str | None:
 
 
 async def start_opcua(link, *, host: str, port: int, security: Security):
-    """Build the station's address space and serve it on the cell behind `link` (a `CellLink` the runner steps).
+    """Build the station's address space and serve it on the cell behind `link` (a `CellLink` on its exchange).
 
     Returns the started `OpcUaServer`; OSError when the port cannot be bound, SecurityError for bad options."""
     from .address_space import build_address_space
@@ -110,21 +110,42 @@ def options_from(args) -> dict | None:
     return {"host": args.opcua_host or args.host, "port": args.opcua, "security": security_from(args)}
 
 
-async def start_opcua_logged(link, *, host: str, port: int, security: Security):
-    """`start_opcua`, with the server's log lines; None (and an error line) when it cannot start."""
-    from twin.modbus.log import log
+class OpcUaFrontEnd:
+    """OPC UA as a front end of a cell (the contract: `twin_app.cell`): `OpcUaFrontEnd.from_args(args)`."""
 
-    try:
-        server = await start_opcua(link, host=host, port=port, security=security)
-    except OSError as exc:
-        log(f"error: OPC UA cannot listen on {host}:{port}: {exc.strerror or exc}")
-        return None
-    except SecurityError as exc:
-        log(f"error: OPC UA security: {exc}")
-        return None
-    policies = ", ".join(security.policies_for(host))
-    users = f", {len(security.accounts)} account(s), no anonymous" if security.accounts else ", anonymous"
-    log(f"OPC UA: namespace {server.space.namespace_uri} (ns={server.ns}), {len(server.space)} variables, "
-        f"security {policies}{users}")
-    log(f"OPC UA listening on {server.endpoint}")
-    return server
+    name = "opcua"
+
+    def __init__(self, *, host: str = "127.0.0.1", port: int = DEFAULT_PORT, security: Security | None = None):
+        self.host, self.port, self.security = host, port, security or Security()
+        self.link = None
+        self.server = None
+
+    @classmethod
+    def from_args(cls, args) -> "OpcUaFrontEnd | None":
+        """The front end `twin serve --opcua ...` asks for, or None without --opcua."""
+        options = options_from(args)
+        return None if options is None else cls(**options)
+
+    async def start(self, cell) -> list[str]:
+        """Raises OSError when the port cannot be bound, TwinError for bad security options."""
+        from twin.core.errors import TwinError
+
+        from .cell_link import CellLink
+
+        self.link = CellLink(cell.exchange, cell.runner)
+        try:
+            self.server = await start_opcua(self.link, host=self.host, port=self.port, security=self.security)
+        except OSError as exc:
+            raise OSError(f"OPC UA cannot listen on {self.host}:{self.port}: {exc.strerror or exc}") from None
+        except SecurityError as exc:
+            raise TwinError(f"OPC UA security: {exc}") from None
+        policies = ", ".join(self.security.policies_for(self.host))
+        users = f", {len(self.security.accounts)} account(s), no anonymous" if self.security.accounts else ", anonymous"
+        return [f"OPC UA: namespace {self.server.space.namespace_uri} (ns={self.server.ns}), {len(self.server.space)} "
+                f"variables, security {policies}{users}", f"OPC UA listening on {self.server.endpoint}"]
+
+    async def close(self) -> None:
+        if self.link is not None:
+            self.link.detach()
+        if self.server is not None:
+            await self.server.close()

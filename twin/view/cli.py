@@ -42,7 +42,8 @@ def _pixels(text: str) -> int:
     return v
 
 
-def add_commands(sub) -> None:
+def add_commands(sub, open_cell) -> None:
+    """`twin view`, `twin plot`, `twin snapshot`; `open_cell(station)` is the application's (it assembles a cell)."""
     p = sub.add_parser("view", help="the cell in 3D in a web browser: live signals, settable inputs, run controls",
                        description="Run a station and serve a live 3D page of it (or replay a recording).")
     p.add_argument("station", nargs="?", help="a station folder or station.toml (or --replay FILE)")
@@ -56,7 +57,7 @@ def add_commands(sub) -> None:
     p.add_argument("--record", metavar="FILE", default=None, help="also record every step into FILE (.parquet or .csv)")
     p.add_argument("--replay", metavar="FILE", default=None, help="play a recording back, with a timeline")
     p.add_argument("--at", type=float, default=None, metavar="T", help="--replay: start at simulated time T (s)")
-    p.set_defaults(func=_view, lockstep=False)
+    p.set_defaults(func=lambda args: _view(args, open_cell), lockstep=False)
 
     p = sub.add_parser("plot", help="plot signals of a recording against simulated time (PNG or SVG)",
                        description="Plot a recording's signals, one panel per unit. Default: finger positions and "
@@ -77,13 +78,13 @@ def add_commands(sub) -> None:
     p.add_argument("-o", "--output", default="cell.png", help="the PNG to write (default cell.png)")
     p.add_argument("--width", type=_pixels, default=960, help="pixels (default 960)")
     p.add_argument("--height", type=_pixels, default=720, help="pixels (default 720)")
-    p.set_defaults(func=_snapshot)
+    p.set_defaults(func=lambda args: _snapshot(args, open_cell))
 
 
-def _view(args) -> int:
+def _view(args, open_cell) -> int:
     from .live import cmd_view
 
-    return cmd_view(args)
+    return cmd_view(args, open_cell)
 
 
 def _plot(args) -> int:
@@ -92,7 +93,16 @@ def _plot(args) -> int:
     return cmd_plot(args)
 
 
-def _snapshot(args) -> int:
+def _snapshot(args, open_cell) -> int:
     from twin.picture import cmd_snapshot
 
-    return cmd_snapshot(args)
+    return cmd_snapshot(args, open_cell)
+
+
+def add_serve_options(p) -> None:
+    """The `twin serve` options of this package: --view [PORT], --view-host, --record FILE."""
+    p.add_argument("--view", nargs="?", type=int, const=8080, default=None, metavar="PORT",
+                   help="also serve the live 3D page (default port 8080; needs the [view] extra)")
+    p.add_argument("--view-host", default="127.0.0.1", help="address the page binds (default loopback)")
+    p.add_argument("--record", metavar="FILE", default=None,
+                   help="record every signal and body pose at every step into FILE (.parquet, or .csv)")

@@ -1,4 +1,4 @@
-"""The live page on a running twin: `twin view STATION` and `twin serve STATION --view [PORT]`.
+"""The live page on a running cell: `twin view STATION` and `twin serve STATION --view [PORT]`.
 
 The runner (`twin.pacing`) steps the twin through the Modbus bridge (`TwinBridge`) in the event loop's
 thread, as `twin serve` does. A `FramePublisher` device takes a frame after a step whenever the page
@@ -15,62 +15,37 @@ import signal
 import sys
 from pathlib import Path
 
-from twin.core.errors import SignalError, SignalRangeError, TwinError
-
-
-def check_write(spec: dict, value) -> str | None:
-    """Why the twin would refuse `value` (SI) for the signal `spec` (a Scene signal), or None when it takes it.
-
-    The same rule and the same message as `Twin.write` (its errors are raised and their text returned)."""
-    name = spec["name"]
-    try:
-        if spec["direction"] != "input":
-            raise SignalError(name, "is an output of the twin and cannot be written")
-        if spec["type"] in ("float", "int"):
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-                raise SignalError(name, f"needs a number, not {value!r}")
-            lo, hi = spec.get("min"), spec.get("max")
-            if lo is not None and hi is not None and not lo <= value <= hi:
-                raise SignalRangeError(name, value, lo, hi, spec.get("unit") or "")
-        if spec["type"] == "enum" and value not in spec.get("choices", ()):
-            raise SignalError(name, f"{value!r} is not one of {', '.join(repr(c) for c in spec['choices'])}")
-    except TwinError as exc:
-        return str(exc)
-    return None
+from twin.core.errors import TwinError
 
 
 class LiveControls:
-    """The page's handle on a running twin: state from the runner and bridge, writes and buttons via the loop."""
+    """The page's handle on a running cell: state from the runner and exchange, writes and buttons via the loop."""
 
-    def __init__(self, publisher, bridge, runner, loop: asyncio.AbstractEventLoop, rmap):
-        self.publisher, self.bridge, self.runner, self.loop, self.rmap = publisher, bridge, runner, loop, rmap
+    def __init__(self, publisher: FramePublisher, exchange, runner, loop: asyncio.AbstractEventLoop):
+        self.publisher, self.exchange, self.runner, self.loop = publisher, exchange, runner, loop
         self.mode = runner.mode
-        self._specs = {s["name"]: s for s in publisher.scene.signals}
         self.writes = 0
 
     def state(self) -> dict:
         r = self.runner
         return {"speed": getattr(r, "speed", 1.0), "paused": bool(getattr(r, "paused", False)),
-                "late_steps": getattr(r, "late_steps", 0), "fault": bool(getattr(self.bridge, "fault", False))}
+                "late_steps": getattr(r, "late_steps", 0), "fault": bool(self.exchange.fault)}
 
     def write(self, name: str, value) -> str | None:
-        spec = self._specs.get(name)
-        if spec is None:
-            return str(SignalError(name, "no such signal in station " + repr(self.publisher.scene.station)))
-        refusal = check_write(spec, value)
-        if refusal is not None:
-            return refusal
-        if name not in self.rmap:
-            return f"signal {name!r}: not served by this server"
-        entry = self.rmap[name]
-        self.loop.call_soon_threadsafe(self._submit, entry, value)
+        """None when the cell takes `value` (SI) at its next step, else why not (the exchange's message)."""
+        try:
+            self.exchange.check(name, value)
+        except TwinError as exc:
+            return str(exc)
+        self.loop.call_soon_threadsafe(self._submit, name, value)
         self.writes += 1
         return None
 
-    def _submit(self, entry, value) -> None:
-        code = self.bridge.submit([(entry, value)])
-        if code:
-            print(f"twin view: write of {entry.name} refused by the server (Modbus exception {code})", file=sys.stderr)
+    def _submit(self, name: str, value) -> None:
+        try:
+            self.exchange.submit([(name, value)])
+        except TwinError as exc:
+            print(f"twin view: write of {name} refused: {exc}", file=sys.stderr)
 
     def buttons(self) -> tuple[str, ...]:
         if self.mode == "lockstep":
@@ -90,12 +65,13 @@ class LiveControls:
 
 
 class LiveView:
-    """A page on a twin served by `bridge` and paced by `runner` (create it in the event loop's thread).
+    """A page on a cell's twin, written through `exchange` and paced by `runner` (create it in the event loop's
+    thread).
 
     The page runs in its own process (`twin.view.process`); this process only publishes frames to it. The
     log says `view on http://HOST:PORT` once the page is up."""
 
-    def __init__(self, twin, bridge, runner, rmap, *, host: str = "127.0.0.1", port: int = 8080, fps: float = 25.0):
+    def __init__(self, twin, exchange, runner, *, host: str = "127.0.0.1", port: int = 8080, fps: float = 25.0):
         from twin.observe import FramePublisher, attach
 
         from .process import PageProcess
@@ -106,7 +82,7 @@ class LiveView:
             raise TwinError(f"the live view needs viser ({exc}): pip install 'gripper-twin[view]'") from None
         self.twin, self.host = twin, host
         self.publisher = FramePublisher(twin)
-        self.controls = LiveControls(self.publisher, bridge, runner, asyncio.get_running_loop(), rmap)
+        self.controls = LiveControls(self.publisher, exchange, runner, asyncio.get_running_loop())
         attach(twin, self.publisher)
         self.page = PageProcess(self.publisher, self.controls, host=host, port=port, fps=fps, on_ready=self._ready)
 
@@ -127,93 +103,62 @@ class LiveView:
 
 
 # -- `twin serve --view/--record` ----------------------------------------------------------------------------------
-def add_serve_options(p) -> None:
-    """The `twin serve` options of this package: --view [PORT], --view-host, --record FILE."""
-    p.add_argument("--view", nargs="?", type=int, const=8080, default=None, metavar="PORT",
-                   help="also serve the live 3D page (default port 8080; needs the [view] extra)")
-    p.add_argument("--view-host", default="127.0.0.1", help="address the page binds (default loopback)")
-    p.add_argument("--record", metavar="FILE", default=None,
-                   help="record every signal and body pose at every step into FILE (.parquet, or .csv)")
+class ViewFrontEnd:
+    """The live page as a front end of a cell (`twin_app.cell`)."""
+
+    name = "view"
+
+    def __init__(self, *, host: str = "127.0.0.1", port: int = 8080, on_ready=None):
+        self.host, self.port, self.on_ready = host, port, on_ready
+        self.live: LiveView | None = None
+
+    async def start(self, cell) -> list[str]:
+        self.live = LiveView(cell.twin, cell.exchange, cell.runner, host=self.host, port=self.port)
+        if self.on_ready is not None:
+            self.on_ready(self.live)
+        return []  # the page says "view on URL" once it is up
+
+    async def close(self) -> None:
+        if self.live is not None:
+            self.live.close()
 
 
-def serve_front_ends(args):
-    """What `twin serve` attaches after creating its bridge and runner: a function (twin, bridge, runner, rmap)
-    that starts the recorder and the page asked for by `args` and returns a function that stops them."""
-    record, view = getattr(args, "record", None), getattr(args, "view", None)
-    if record is None and view is None:
-        return None
+class RecorderFrontEnd:
+    """`--record FILE` as a front end of a cell: every signal and body pose at every step."""
 
-    def start(twin, bridge, runner, rmap):
-        from twin.modbus.log import announce as log
+    name = "record"
 
-        stoppers = []
-        if record is not None:
-            from twin.recording import Recorder
+    def __init__(self, path: str):
+        self.path = path
+        self.recorder = None
 
-            rec = Recorder(twin, record)
-            log(f"recording every step into {record}")
-            stoppers.append(lambda: (rec.close(), log(f"recording: {rec.rows} rows in {record}")))
-        if view is not None:
-            live = LiveView(twin, bridge, runner, rmap, host=args.view_host, port=view)  # logs "view on URL"
-            stoppers.append(live.close)
+    async def start(self, cell) -> list[str]:
+        from twin.recording import Recorder
 
-        def stop():
-            for s in reversed(stoppers):
-                s()
-        return stop
+        self.recorder = Recorder(cell.twin, self.path)
+        return [f"recording every step into {self.path}"]
 
-    return start
+    async def close(self) -> None:
+        if self.recorder is not None:
+            from twin.modbus.log import announce
+
+            self.recorder.close()
+            announce(f"recording: {self.recorder.rows} rows in {self.path}")
+
+
+def front_ends_from_args(args) -> list:
+    """The front ends `twin serve --record FILE --view [PORT]` asks for (in that order)."""
+    fronts = []
+    if getattr(args, "record", None) is not None:
+        fronts.append(RecorderFrontEnd(args.record))
+    if getattr(args, "view", None) is not None:
+        fronts.append(ViewFrontEnd(host=args.view_host, port=args.view))
+    return fronts
 
 
 # -- `twin view STATION` ---------------------------------------------------------------------------------------------
-async def run_view(twin, rmap, *, host: str, port: int, lockstep: bool, speed: float, paused: bool,
-                   record: str | None = None, stop: asyncio.Event | None = None, on_ready=None) -> int:
-    """Run `twin` paced by a runner, with the page (and a recorder), until SIGINT/SIGTERM or `stop`."""
-    from twin.modbus.bridge import TwinBridge
-    from twin.modbus.log import announce as log
-    from twin.pacing import LockstepRunner, RealtimeRunner
-
-    loop = asyncio.get_running_loop()
-    stop = stop or asyncio.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        try:
-            loop.add_signal_handler(sig, stop.set)
-        except (NotImplementedError, RuntimeError, ValueError):
-            pass
-    bridge = TwinBridge(twin, rmap, log=log)
-    runner = LockstepRunner(bridge.step) if lockstep else RealtimeRunner(bridge.step, twin.dt, speed)
-    bridge.runner = runner
-    if paused and not lockstep:
-        runner.pause()
-    recorder = None
-    if record is not None:
-        from twin.recording import Recorder
-
-        recorder = Recorder(twin, record)
-    live = LiveView(twin, bridge, runner, rmap, host=host, port=port)
-    how = "lockstep (Step / Advance on the page)" if lockstep else f"real time x{speed:g}" + (", paused" if paused else "")
-    log(f"station {twin.station.name!r}: {how}, step {twin.dt * 1000:g} ms")
-    if on_ready is not None:
-        on_ready(live)
-    task = asyncio.ensure_future(runner.run())
-    stopper = asyncio.ensure_future(stop.wait())
-    await asyncio.wait({task, stopper}, return_when=asyncio.FIRST_COMPLETED)
-    if task.done() and not stop.is_set():
-        await stop.wait()  # faulted: keep showing the last state until stopped
-    runner.stop()
-    for t in (task, stopper):
-        if not t.done():
-            t.cancel()
-    await asyncio.gather(task, stopper, return_exceptions=True)
-    live.close()
-    if recorder is not None:
-        recorder.close()
-        log(f"recording: {recorder.rows} rows in {record}")
-    log(f"stopped after {twin.step_count} steps ({twin.time:.3f} s simulated)")
-    return 0
-
-
-def cmd_view(args) -> int:
+def cmd_view(args, open_cell) -> int:
+    """`twin view`: `open_cell(station)` (the application's) gives the cell; the page (and a recorder) serve it."""
     from twin.modbus.log import announce as log
 
     if args.replay is not None:
@@ -226,15 +171,12 @@ def cmd_view(args) -> int:
         import viser  # noqa: F401
     except ImportError:
         raise TwinError("the live view needs viser: pip install 'gripper-twin[view]'") from None
-    from twin.cell import open_cell
-    from twin.modbus.cli import controller_log
-    from twin.modbus.register_map import build_register_map
-
     log(f"loading station {args.station}")
-    twin = open_cell(Path(args.station), on_event=controller_log)
+    cell = open_cell(Path(args.station))
     try:
-        rmap = build_register_map(twin.signals, twin.station.name)
-        return asyncio.run(run_view(twin, rmap, host=args.host, port=args.port, lockstep=args.lockstep,
-                                    speed=args.speed, paused=args.paused, record=args.record))
+        if args.record is not None:
+            cell.add_front_end(RecorderFrontEnd(args.record))
+        cell.add_front_end(ViewFrontEnd(host=args.host, port=args.port))
+        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, paused=args.paused))
     finally:
-        twin.close()
+        cell.close()

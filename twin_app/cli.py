@@ -1,0 +1,266 @@
+"""The `twin` command: inspect grippers and stations, run the demo, serve a station, run campaigns.
+
+    twin info STATION_OR_URDF [--json]
+    twin serve STATION [Modbus flags: twin.modbus.cli] [--realtime | --lockstep] [--speed X]
+    twin map STATION [--format json|csv|md]
+    twin demo [STATION] [--cycles N]
+    twin campaign ... (twin_app.campaign)
+
+`serve` assembles the cell (`twin_app.cell.Cell`) and plugs its front ends in (Modbus/TCP:
+`twin.modbus.front_end`). It logs to stderr through `twin.modbus.log`: a line when it starts loading the
+station, one when listening (with the bound port, so `--port 0` is usable), one when stopped; it stops
+cleanly on Ctrl-C or SIGTERM (exit 0); one that comes while the station is loading stops it once loaded.
+
+User errors (a wrong station file, an unknown URDF, a bad signal) print one line on stderr and exit
+with status 2; data goes to stdout.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import signal
+import sys
+from pathlib import Path
+
+from twin.core.errors import TwinError
+from twin.modbus.cli import add_commands as add_modbus_commands, tls_from_args
+from twin.modbus.log import announce, log as _log
+
+
+INFO_TARGETS = "a gripper .urdf, a station folder or a station.toml"
+
+
+def _mechanism_of(target: str):
+    from twin.core.errors import StationError
+    from twin.core.mechanism import load_mechanism
+    from twin.core.station import gripper_mechanism, load_station
+
+    path = Path(target)
+    if path.suffix.lower() == ".urdf":
+        return load_mechanism(path)
+    if path.is_dir() and not (path / "station.toml").exists():
+        raise StationError(target, "", f"a folder without station.toml: twin info needs {INFO_TARGETS}")
+    if not path.is_dir() and path.suffix.lower() != ".toml":
+        raise StationError(target, "", f"twin info needs {INFO_TARGETS}, not a {path.suffix or 'file without suffix'}")
+    return gripper_mechanism(load_station(path))
+
+
+def _remarks(mech) -> list[str]:
+    """What `twin info` adds below the table: choices the twin made, and why a station may refuse it."""
+    lines = [f"note: input {i.name}: {i.note}" for i in mech.inputs if i.note]
+    if mech.rigid_joints:
+        lines.append("note: " + ", ".join(f"joint {j} ({t})" for j, t in mech.rigid_joints)
+                     + ": treated as rigid (only prismatic, revolute and continuous joints become inputs)")
+    if not mech.fingers:
+        lines.append("warning: no finger detected (no movable link, with the links fixed to it, has collision "
+                     "geometry): a station with this gripper must name its fingers (gripper.fingers)")
+    return lines
+
+
+def cmd_info(args) -> int:
+    mech = _mechanism_of(args.target)
+    if args.json:
+        print(json.dumps(mech.as_dict(), indent=2))
+        for line in _remarks(mech):
+            print(line, file=sys.stderr)  # stdout stays pure JSON
+        return 0
+    print(f"gripper: {mech.robot_name} ({mech.urdf})")
+    print(f"base link (attach point): {mech.base_link}")
+    rows = [("input", "joint", "type", "min", "max", "unit")]
+    rows += [(i.name, i.joint, i.type, f"{i.min:g}", f"{i.max:g}", i.unit) for i in mech.inputs]
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    for n, row in enumerate(rows):
+        print("  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        if n == 0:
+            print("  ".join("-" * w for w in widths))
+    for m in mech.mimics:
+        print(f"mimic: {m.joint} follows {m.master} (x{m.multiplier:g} {m.offset:+g}), no input of its own")
+    print(f"fingers ({len(mech.fingers)}): " + ", ".join(f.label for f in mech.fingers))
+    for line in _remarks(mech):
+        print(line)
+    return 0
+
+
+def cmd_demo(args) -> int:
+    from twin.demo import run_demo
+
+    return run_demo(args.station, cycles=args.cycles)
+
+
+def controller_log(event: dict) -> None:
+    """What the robot controller says, in the server's log: TPWrite lines, a runtime error, the end."""
+    kind, t = event.get("type"), event.get("t", 0.0)
+    if kind == "print":
+        _log(f"[t={t:.3f} s] robot: {event['text']}")
+    elif kind == "error":
+        _log(f"[t={t:.3f} s] robot program error at line {event['line']}: {event['message']}")
+    elif kind == "end":
+        _log(f"[t={t:.3f} s] robot program ended ({event['reason']})")
+
+
+class StopRequested(BaseException):
+    """A second SIGINT or SIGTERM while the station is loading: cut the loading short. A BaseException,
+    so that no `except Exception` on the way out of the loaders swallows it."""
+
+
+class _StartUpSignals:
+    """SIGINT/SIGTERM before the event loop takes them over (loading the station takes a while).
+
+    The first one is remembered (and sets `stop`): the server stops cleanly as soon as the station is
+    loaded. It does not raise, for an exception raised there lands in whatever is loading: numpy's
+    import turns it into an ImportError, which pybullet prints. A second one cuts the loading short
+    (StopRequested). Once stopping, signals are ignored, so none can interrupt the shutdown."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self, stop: asyncio.Event):
+        self.stop = stop
+        self.received: int | None = None
+        self.stopping = False
+        self.previous = {}
+        try:
+            for sig in self.SIGNALS:
+                self.previous[sig] = signal.signal(sig, self._on_signal)
+        except ValueError:  # not the main thread: signals are the caller's business
+            pass
+
+    def _on_signal(self, signum, frame) -> None:
+        if self.stopping:
+            return
+        if self.received is None:
+            self.received = signum
+            self.stop.set()
+            return
+        self.stopping = True
+        raise StopRequested(signum)
+
+    def ignore(self) -> None:
+        """Stopping: the event loop has put back the default handlers; take the signals again."""
+        self.stopping = True
+        for sig in self.previous:
+            signal.signal(sig, self._on_signal)
+
+    def restore(self) -> None:
+        for sig, handler in self.previous.items():
+            signal.signal(sig, handler)
+
+
+def open_served_cell(station):
+    """A station's cell as the servers run it, its robot controller's words in the log."""
+    from .cell import Cell
+
+    return Cell(Path(station), on_event=controller_log)
+
+
+def cmd_serve(args) -> int:
+    import asyncio
+
+    from twin.modbus import log as serve_log
+
+    serve_log.setup(args.log_level)
+    from twin.opcua.serve import check_arguments as check_opcua_arguments
+
+    if (problem := check_opcua_arguments(args)) is not None:
+        print(f"twin serve: error: {problem}", file=sys.stderr)
+        return 2
+    stop = asyncio.Event()
+    signals = _StartUpSignals(stop)  # first thing: loading the station (pybullet) takes a while
+    cell = None
+    try:
+        tls = tls_from_args(args)
+        if isinstance(tls, int):
+            return tls
+        if args.profile and args.unit_id is not None and args.unit_id == args.map_unit_id:
+            _log(f"error: --unit-id {args.unit_id} is also the --map-unit-id: give them different unit ids", logging.ERROR)
+            return 2
+        announce(f"loading station {args.station}")
+        from twin.modbus.front_end import ModbusFrontEnd
+
+        cell = open_served_cell(args.station)
+        if getattr(args, "faults", None):
+            from twin.faults import FaultInjector
+
+            from .campaign.faultfile import load_fault_file
+            from .campaign.spec import SpecError
+
+            try:
+                FaultInjector.attach(cell.twin, load_fault_file(args.faults, cell.twin))
+            except SpecError as exc:
+                _log(f"error: --faults: {exc}", logging.ERROR)
+                return 2
+        if not (getattr(args, "no_modbus", False) and tls is None):
+            cell.add_front_end(ModbusFrontEnd.from_args(args, tls=tls))
+        from twin.opcua.serve import OpcUaFrontEnd
+
+        opcua = OpcUaFrontEnd.from_args(args)
+        if opcua is not None:
+            cell.add_front_end(opcua)
+        from twin.view.live import front_ends_from_args  # --record, --view
+
+        for front in front_ends_from_args(args):
+            cell.add_front_end(front)
+        if signals.received is not None:
+            raise StopRequested(signals.received)
+        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, stop=stop))
+    except BaseException:
+        if signals.received is None:
+            raise
+        announce(f"stopped by {signal.Signals(signals.received).name} while starting")
+        return 0
+    finally:
+        signals.ignore()
+        try:
+            if cell is not None:
+                cell.close()
+        finally:
+            signals.restore()
+            serve_log.flush()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="twin", description="gripper-twin: a digital twin of a gripper cell")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("info", help="show the inputs, fingers and base link of a gripper URDF or a station's gripper")
+    p.add_argument("target", help="a gripper .urdf file, a station.toml or a station folder")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.set_defaults(func=cmd_info)
+    p = sub.add_parser("demo", help="run the headless demo of the ring rig (stations/ring_rig or a station like it) and print what happens")
+    p.add_argument("station", nargs="?", default=str(Path(__file__).resolve().parent.parent / "stations" / "ring_rig"))
+    p.add_argument("--cycles", type=int, default=1, help="how many full cycles to run")
+    p.set_defaults(func=cmd_demo)
+    from .campaign.cli import add_command as add_campaign
+
+    add_campaign(sub)
+    serve = add_modbus_commands(sub, cmd_serve)
+    from twin.view.cli import add_commands as add_view_commands  # view, plot, snapshot
+    from twin.view.cli import add_serve_options  # serve --view [PORT], --record FILE
+
+    add_serve_options(serve)
+    from twin.opcua.serve import add_arguments as add_opcua_arguments  # --opcua [PORT], --no-modbus, --opcua-*
+
+    add_opcua_arguments(serve)
+    add_view_commands(sub, open_served_cell)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except TwinError as exc:
+        print(f"twin: error: {exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:
+        from rapid_like.errors import RapidError
+
+        if not isinstance(exc, RapidError):
+            raise
+        print(f"twin: {exc.headline()}", file=sys.stderr)  # the station's RAPID program: FILE:LINE:COL
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
