@@ -7,21 +7,19 @@ import struct
 import pytest
 
 from tests.conftest import STATIONS
-from twin.cell import open_cell
+from twin_app.cell import open_cell
 from twin.modbus.bridge import TwinBridge
-from twin.modbus.register_map import build_register_map
 
 
 def test_ao_axis1_mirrors_l2_whoever_wrote_it():
     with open_cell(STATIONS / "ring_rig") as twin:
-        rmap = build_register_map(twin.signals, twin.station.name)
-        bridge = TwinBridge(twin, rmap, log=lambda text: None)
+        rmap = twin.register_map
+        bridge = TwinBridge(twin.exchange, rmap)
         e = rmap["aoAxis1"]
         assert e.table == "input_register"
         for mm in (350.0, 281.5):
             twin.write("L2", mm / 1000)  # as the PLC's Modbus write does (the bridge's queue, applied at a step)
             twin.step()
-            bridge.publish()
             assert twin.read("aoAxis1") == pytest.approx(mm)
             words = list(struct.unpack(f">{e.count}H", bridge.images.input_registers[2 * e.address:2 * e.end]))
             assert e.decode(words) == pytest.approx(mm, abs=1e-3)

@@ -23,6 +23,8 @@ class OpcUaServerProcess:
     """`twin serve STATION --port 0 --opcua 0 ARGS...`; `url` is the OPC UA endpoint, `port` Modbus's (None with
     --no-modbus). Its stderr is collected line by line in `lines`."""
 
+    drain = True  # read the server's log to the end (ServerProcess's reader stops at "listening on" otherwise)
+
     def __init__(self, station, *args: str, cert_dir=None):
         extra = ["--opcua-cert-dir", str(cert_dir)] if cert_dir is not None else []
         self.cmd = [sys.executable, "-m", "twin", "serve", str(station), "--port", "0", "--opcua", "0", *extra, *args]
