@@ -83,7 +83,7 @@ def realtime_run(seconds: float, view: bool, browser, record: bool | None = None
 def lockstep_cost(steps: int, blocks: int = 6) -> dict:
     """Blocks of steps without and with the recorder attached, alternately; the file's last write and
     footer (at close) are spread over the recorded steps."""
-    from twin.cell import open_cell
+    from twin_app.cell import open_cell
     from twin.observe import attach, detach
     from twin.recording import Recorder
 

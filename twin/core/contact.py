@@ -12,7 +12,7 @@ from __future__ import annotations
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
-from ..native_output import quiet_native_output
+from .native_output import quiet_native_output
 
 PROBE_MARGIN = 0.00001  # m: the copies' margin (a hull's lies outside it and is counted off)
 
