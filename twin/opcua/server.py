@@ -48,6 +48,7 @@ INTEGER_VARIANTS = frozenset({ua.VariantType.SByte, ua.VariantType.Byte, ua.Vari
 LIMITS = {INT32: (-2**31, 2**31 - 1), UINT32: (0, 2**32 - 1), INT64: (-2**63, 2**63 - 1)}
 MAX_ADVANCE = 2**32 - 1
 QUEUE_CAP = 10_000  # the largest queue a monitored item is given
+FASTEST_STEP_MS = 0.5  # wall time of a step at the fastest a cell runs (lockstep, --speed): sizes the queues
 
 Submit = Callable[[Sequence[tuple[Variable, object]]], str | None]  # -> None, or the name of a Bad status code
 Advance = Callable[[int], Awaitable[int]]  # lockstep: run n steps, return the step count when done
@@ -304,8 +305,9 @@ class OpcUaServer:
                 interval = publishing
             interval = self._revised_interval(interval)
             sampling.append(interval)
-            # every step of one publishing interval fits the queue, with room for a late publish
-            needed = 2 * math.ceil(publishing / self.step_ms) + 2
+            # every step of one publishing interval fits the queue, with room for a late publish; steps come
+            # faster than real time in lockstep or at --speed > 1, so count them at the fastest rate a cell steps
+            needed = 2 * math.ceil(publishing / min(self.step_ms, FASTEST_STEP_MS)) + 2
             p.QueueSize = min(QUEUE_CAP, max(int(p.QueueSize or 0), needed))
         return sampling
 
