@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 from .core.errors import SignalError
 from .core.signals import FLOAT, INPUT
+from .core.device import ObservingDevice
 
 EPS = 1e-9
 JAM_REACHED = {"m": 0.0001, "rad": 0.001}  # a joint this close to its jam position is stuck there
@@ -286,7 +287,7 @@ def _check_output(fault: Fault, twin, name: str):
 
 
 @dataclass
-class FaultInjector:
+class FaultInjector(ObservingDevice):
     """The faults of one run, as a `Device` of the twin: each starts and ends at its simulated time."""
 
     faults: list[Fault]
@@ -305,12 +306,6 @@ class FaultInjector:
             fault.check(twin)
         twin.add_device(injector)
         return injector
-
-    def read(self, name: str):  # no signals of its own
-        raise KeyError(name)
-
-    def write(self, name: str, value) -> None:
-        raise KeyError(name)
 
     def before_step(self, twin) -> None:
         t = twin.time

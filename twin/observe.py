@@ -18,6 +18,7 @@ import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
+from .core.device import ObservingDevice
 
 GEOMETRY = {2: "sphere", 3: "box", 4: "cylinder", 5: "mesh", 6: "plane", 7: "capsule"}  # pybullet GEOM_*
 POSE_FIELDS = ("x", "y", "z", "qx", "qy", "qz", "qw")
@@ -224,7 +225,7 @@ class Observer:
                      np.asarray(joints, dtype=float))
 
 
-class FramePublisher:
+class FramePublisher(ObservingDevice):
     """A twin device that publishes the latest frame for front ends in other threads.
 
     Taking a frame costs pybullet calls, so it takes one only when some reader has asked for one
@@ -244,15 +245,6 @@ class FramePublisher:
 
     def request(self) -> None:
         self._wanted = True
-
-    def read(self, name):  # pragma: no cover - no signals
-        raise KeyError(name)
-
-    def write(self, name, value):  # pragma: no cover - no signals
-        raise KeyError(name)
-
-    def before_step(self, twin) -> None:
-        pass
 
     def after_step(self, twin) -> None:
         self.stale = True

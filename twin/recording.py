@@ -41,6 +41,7 @@ import numpy as np
 
 from .core.errors import TwinError
 from .observe import POSE_FIELDS, Frame, Observer, Scene, attach, detach
+from .core.device import ObservingDevice
 
 FORMAT_VERSION = 1
 META_KEY = "gripper_twin"
@@ -69,7 +70,7 @@ def _meta(scene: Scene) -> str:
     return json.dumps({"format": FORMAT_VERSION, "scene": scene.as_dict()}, sort_keys=True)
 
 
-class Recorder:
+class Recorder(ObservingDevice):
     """Records a twin at every step into `path` (see the module docstring). Close it to finish the file."""
 
     signals: tuple = ()  # a device of the twin with no signals of its own
@@ -97,15 +98,6 @@ class Recorder:
         attach(twin, self)
 
     # -- the twin's side (as a device) --------------------------------------------------------------------
-    def read(self, name):  # pragma: no cover - no signals
-        raise KeyError(name)
-
-    def write(self, name, value):  # pragma: no cover - no signals
-        raise KeyError(name)
-
-    def before_step(self, twin) -> None:
-        pass
-
     def after_step(self, twin) -> None:
         self.capture()
 

@@ -11,33 +11,16 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Protocol
 
 from .errors import MotionError, SignalError, StationError
 from .gripper import Gripper
 from .mechanism import Mechanism, load_mechanism
 from .signal_table import IN_POSITION_TOLERANCE, MOVING_SPEED, twin_signals
+from .device import Device
 from .signals import INPUT, OUTPUT, SignalSpec
 from .station import Station, load_station
 from .world import ROBOT_PREFIX, World, quat
 
-
-
-class Device(Protocol):
-    """Something stepped with the twin that adds signals of its own (e.g. the RAPID robot controller).
-
-    The core knows devices only through this protocol, so it never imports what drives it.
-    """
-
-    signals: tuple[SignalSpec, ...]
-
-    def read(self, name: str): ...
-
-    def write(self, name: str, value) -> None: ...
-
-    def before_step(self, twin: "Twin") -> None: ...
-
-    def after_step(self, twin: "Twin") -> None: ...
 
 
 class Twin:

@@ -13,11 +13,10 @@ Link faults (`link_lost`, `link_latency`) belong to the PLC's side of the link: 
 """
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from types import SimpleNamespace
 
-from .spec import LINK_KINDS, SpecError, _fault, _Station
+from .spec import LINK_KINDS, SpecError, _fault, _Station, read_toml
 
 
 def load_fault_file(path: str | Path, twin) -> list:
@@ -27,12 +26,7 @@ def load_fault_file(path: str | Path, twin) -> list:
     from .scenario import ScenarioError, build_faults
 
     file = Path(path)
-    try:
-        data = tomllib.loads(file.read_text())
-    except OSError as exc:
-        raise SpecError(file, "", f"cannot be read: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(file, "", f"is not valid TOML: {exc}") from None
+    data = read_toml(file)
     for key in data:
         if key != "faults":
             raise SpecError(file, key, "a faults file has only [faults.NAME] tables")

@@ -10,6 +10,7 @@ from typing import Any
 
 from .loading import load_object
 from .spec import Campaign, Scenario
+from twin.core.device import ObservingDevice
 
 UNIT_TO_MAP = {"m": 1000.0, "rad": 180.0 / math.pi}  # SI -> the map's units (mm, deg), as a PLC sees them
 # wall seconds of the last scenario run in this process: loading the station, running the driver (for the
@@ -152,7 +153,7 @@ def _unit(twin, signal: str, fault: str) -> str:
 
 
 # -- what is watched while it runs ---------------------------------------------------------------------------
-class Monitor:
+class Monitor(ObservingDevice):
     """A device stepped with the twin: the true finger forces (not the readings), grips, slip."""
 
     signals: tuple = ()
@@ -162,15 +163,6 @@ class Monitor:
         self.gripped_edges = 0
         self.slip = False if "slip" in {s.name for s in twin.signals} else None
         self._was_gripped = bool(twin.read("doGripped"))
-
-    def read(self, name):
-        raise KeyError(name)
-
-    def write(self, name, value):
-        raise KeyError(name)
-
-    def before_step(self, twin) -> None:
-        pass
 
     def after_step(self, twin) -> None:
         forces = twin.finger_forces()

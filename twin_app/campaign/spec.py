@@ -166,15 +166,20 @@ class _Station:
         self.fingers = [f.name for f in mech.fingers]
 
 
-def load_campaign(path: str | Path) -> Campaign:
-    """Read and check a campaign file; its scenarios are expanded (matrix, list, samples) in order."""
-    file = Path(path)
+def read_toml(file: Path) -> dict:
+    """A campaign or faults file's tables; a file that cannot be read or parsed is a SpecError naming it."""
     try:
-        data = tomllib.loads(file.read_text())
+        return tomllib.loads(file.read_text())
     except OSError as exc:
         raise SpecError(file, "", f"cannot be read: {exc.strerror or exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(file, "", f"is not valid TOML: {exc}") from None
+
+
+def load_campaign(path: str | Path) -> Campaign:
+    """Read and check a campaign file; its scenarios are expanded (matrix, list, samples) in order."""
+    file = Path(path)
+    data = read_toml(file)
     known = {"campaign", "driver", "start", "run", "parameters", "matrix", "scenarios", "sample", "faults",
              "expect", "measure"}
     for k in data:
