@@ -2,6 +2,9 @@
 PLC and the thesis's grip sequence.
 
     from plc_client import TwinClient, ScanCycle, ClientIO, GripSequence
+
+`RegisterMap` and `MapError` are the server's own (`twin.modbus.register_map`), re-exported: one map type
+and one map error on both sides of the wire.
 """
 from .client import ClientIO, RegisterMap, Signal, TwinClient
 from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, OutputRefusedError,

@@ -24,7 +24,11 @@ import argparse
 import logging
 import sys
 
-from .client import RegisterMap, Signal, TwinClient, range_text
+from twin.core.errors import TwinError
+from twin.modbus.protocol import DEFAULT_PORT, TLS_PORT
+
+from .checks import check_names, check_value, lookup, range_text
+from .client import RegisterMap, Signal, TwinClient
 from .errors import ConnectionFailedError, ModbusExceptionError, OutputRefusedError, PlcClientError, SignalValueError
 
 EXIT_USER, EXIT_CONNECTION = 2, 1
@@ -142,13 +146,13 @@ def tls_files(args):
 def connect(args, rmap: RegisterMap) -> TwinClient:
     tls = tls_files(args)
     if args.port is None:
-        args.port = 802 if tls is not None else 5020
+        args.port = TLS_PORT if tls is not None else DEFAULT_PORT
     return TwinClient.connect(args.host, args.port, args.unit_id, map=rmap, timeout=args.timeout, tls=tls)
 
 
 def cmd_read(args) -> int:
     rmap = load_map(args)
-    signals = rmap.check_names(args.names)
+    signals = check_names(rmap, args.names)
     with connect(args, rmap) as client:
         values = client.read(*args.names)
     print_rows([read_row(s, values[s.name]) for s in signals])
@@ -171,9 +175,9 @@ def cmd_write(args) -> int:
         name, sep, raw = text.partition("=")
         if not sep or not name:
             raise UsageError(f"{text!r}: write takes NAME=VALUE")
-        values[name.strip()] = parse_value(rmap[name.strip()], raw.strip())
+        values[name.strip()] = parse_value(lookup(rmap, name.strip()), raw.strip())
     for name, value in values.items():
-        rmap.check_value(name, value)
+        check_value(rmap, name, value)
     with connect(args, rmap) as client:
         client.write(values)
     print_rows([(n, fmt(v), rmap[n].unit) for n, v in values.items()])
@@ -182,7 +186,7 @@ def cmd_write(args) -> int:
 
 def cmd_watch(args) -> int:
     rmap = load_map(args)
-    signals = rmap.check_names(args.names)
+    signals = check_names(rmap, args.names)
     if args.interval <= 0:
         raise UsageError("--interval must be greater than 0")
     if args.count is not None and args.count < 1:
@@ -354,7 +358,7 @@ def main(argv: list[str] | None = None) -> int:
     except (ConnectionFailedError, ModbusExceptionError) as exc:
         print(f"plc: error: {exc}", file=sys.stderr)
         return EXIT_CONNECTION
-    except PlcClientError as exc:
+    except TwinError as exc:  # PlcClientError, MapError (a map that cannot be loaded or is not the server's)
         print(f"plc: error: {exc}", file=sys.stderr)
         return EXIT_USER
     except BrokenPipeError:  # `plc watch ... | head`

@@ -7,41 +7,38 @@
         plc.read("L2.actual", "L2.force", "doGripped")   # {'L2.actual': 329.9, 'L2.force': 3.1, 'doGripped': False}
         for t, values in plc.poll(["L2.force"], interval=0.1, count=10): ...
 
-The register map comes from `twin map STATION --format json` output (a file) or from a station (built
-with the server's own `twin.modbus.register_map`, so both sides agree). A batch read groups signals at
-contiguous addresses of one table into one request. Values are checked against the map before anything
-is sent: an unknown name or an out-of-range value (an entry without a range: its type's, whole numbers
-for integer types of scale 1, finite float32) raises before the wire (see `plc_client.errors`). A write
-sends `sim.advance` last. On connect, a map with `sim.map_crc` is checked against the server's CRC: a
-map of another station raises `MapError` instead of reading wrong values.
+The register map is the server's own type, `twin.modbus.register_map.RegisterMap` (also importable as
+`plc_client.RegisterMap`), loaded from `twin map STATION --format json` output (`RegisterMap.from_json`)
+or from a station (`RegisterMap.from_station`: the map the server builds, without physics), so both
+sides agree. A batch read groups signals at contiguous addresses of one table into one request. Values
+are checked against the map before anything is sent (`plc_client.checks`): an unknown name or an
+out-of-range value (an entry without a range: its type's, whole numbers for integer types of scale 1,
+finite float32) raises before the wire (see `plc_client.errors`). A write sends `sim.advance` last. On
+connect, a map with `sim.map_crc` is checked against the server's CRC: a map of another station raises
+`MapError` instead of reading wrong values.
 """
 from __future__ import annotations
 
-import json
 import math
 import ssl
 import threading
 import time
 from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import (ConnectionFailedError, MapError, ModbusExceptionError, NotWritableError, PlcClientError,
-                     SignalValueError, UnknownSignalError, ValueOutOfRangeError)
+from twin.modbus.protocol import (DEFAULT_PORT, MAX_READ_BITS, MAX_READ_REGISTERS, MAX_RW_WRITE, MAX_WRITE_BITS,
+                                  MAX_WRITE_REGISTERS, TLS_PORT)
+from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
+                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, STEP, TABLES, WATCHDOG_MS, Entry, MapError,
+                                      RegisterMap)
+
+from .checks import check_names, check_value, lookup, range_text  # noqa: F401 (range_text: plc map's)
+from .errors import ConnectionFailedError, ModbusExceptionError, PlcClientError
 from .scan import LocalSignals
 
-
-from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
-                                      INPUT_REGISTER, LOCKSTEP, MAP_CRC, STEP, TABLES, TYPE_LIMITS, WATCHDOG_MS, Entry,
-                                      map_crc)
-
 Signal = Entry  # one entry of the register map, as the server builds it (twin.modbus.register_map)
-WRITABLE_TABLES = (COIL, HOLDING_REGISTER)
-MAX_REGISTERS, MAX_BITS = 125, 2000  # per read request (the protocol's limits)
-MAX_WRITE_REGISTERS, MAX_WRITE_BITS = 123, 1968
-MAX_RW_WRITE = 121
-FLOAT32_MAX = 3.4028234663852886e38
 
 
 @dataclass(frozen=True)
@@ -65,168 +62,12 @@ class TlsFiles:
         return ctx
 
 
-def range_text(s: Signal) -> str:
-    if s.type == "bool":
-        return "0/1"
-    if s.choices:
-        return "|".join(c or '""' for c in s.choices)
-    lo = "" if s.min is None else f"{s.min:.10g}"
-    hi = "" if s.max is None else f"{s.max:.10g}"
-    return f"{lo}..{hi}" if (lo or hi) else ""
-
-
-class RegisterMap:
-    """The signals by name, as published by the server."""
-
-    def __init__(self, signals: Iterable[Signal], meta: Mapping[str, Any] | None = None, source: str = ""):
-        self.signals: dict[str, Signal] = {}
-        for s in signals:
-            if s.table not in TABLES:
-                raise MapError(f"signal {s.name!r}: unknown table {s.table!r} (one of {', '.join(TABLES)})")
-            # the client speaks engineering units: encode(value) takes them as they are (factor 1)
-            self.signals[s.name] = replace(s, factor=1.0, signal=None)
-        self.meta = dict(meta or {})
-        self.source = source  # where the map came from, for messages: a file, or "station NAME"
-        self.mapped: dict[str, set[int]] = {t: set() for t in TABLES}  # the addresses a read may cover
-        for s in self.signals.values():
-            self.mapped[s.table].update(range(s.address, s.address + s.count))
-
-    # -- loading ------------------------------------------------------------------------------------
-    @classmethod
-    def from_json(cls, source: str | Path | Mapping | list) -> "RegisterMap":
-        """From `twin map --format json` output: a file path, its text, or the parsed data."""
-        where = "register map"
-        if isinstance(source, Path) or (isinstance(source, str) and not source.lstrip().startswith(("{", "["))):
-            where = str(source)
-            try:
-                source = Path(source).read_text(encoding="utf-8")
-            except OSError as exc:
-                raise MapError(f"{where}: cannot read the register map: {exc.strerror or exc}") from None
-        if isinstance(source, str):
-            try:
-                source = json.loads(source)
-            except json.JSONDecodeError as exc:
-                raise MapError(f"{where}: not JSON (line {exc.lineno}: {exc.msg}); "
-                               f"make one with `twin map STATION --format json`") from None
-        data = source
-        meta: dict = {}
-        if isinstance(data, Mapping):
-            meta = {k: v for k, v in data.items() if k not in ("signals", "entries", "registers")}
-            data = data.get("signals", data.get("entries", data.get("registers")))
-        if not isinstance(data, list):
-            raise MapError(f"{where}: expected a list of signals (the output of `twin map STATION --format json`)")
-        return cls((_signal_from_dict(e, where, i) for i, e in enumerate(data)), meta,
-                   where if where != "register map" else "")
-
-    @classmethod
-    def from_station(cls, station: str | Path) -> "RegisterMap":
-        """The map the server serves for this station, from the station's static signal table (the server's own
-        map builder; no physics starts)."""
-        from twin.core.errors import TwinError
-        from twin.modbus import register_map as rm
-
-        try:
-            built = rm.build_map(station)
-        except (TwinError, rm.MapError) as exc:
-            raise MapError(str(exc)) from None
-        return cls(built.entries, {"station": built.station}, f"station {built.station!r}")
-
-    @property
-    def crc(self) -> int:
-        """The CRC-32 of the map, as the server publishes it in `sim.map_crc` (`twin.modbus.register_map.map_crc`)."""
-        return map_crc(self.signals.values())
-
-    def as_list(self) -> list[dict]:
-        """The map as `twin map --format json` prints it."""
-        return [s.as_dict() for s in self.signals.values()]
-
-    # -- lookup -------------------------------------------------------------------------------------
-    def __getitem__(self, name: str) -> Signal:
-        try:
-            return self.signals[name]
-        except KeyError:
-            raise UnknownSignalError(name, self.signals) from None
-
-    def __contains__(self, name: object) -> bool:
-        return name in self.signals
-
-    def __iter__(self) -> Iterator[Signal]:
-        return iter(self.signals.values())
-
-    def __len__(self) -> int:
-        return len(self.signals)
-
-    def check_names(self, names: Iterable[str]) -> list[Signal]:
-        return [self[n] for n in names]
-
-    # -- values -------------------------------------------------------------------------------------
-    def check_value(self, name: str, value: Any) -> Any:
-        """The value in engineering units, checked against the map (not yet encoded)."""
-        s = self[name]
-        if not s.writable:
-            raise NotWritableError(name)
-        return _check(s, value)
-
-
-def _signal_from_dict(e: Any, where: str, i: int) -> Signal:
-    if not isinstance(e, Mapping) or "name" not in e or "table" not in e or "address" not in e:
-        raise MapError(f"{where}: entry {i} needs at least name, table and address")
-    try:
-        bit = e["table"] in BIT_TABLES
-        return Signal(name=str(e["name"]), table=str(e["table"]), address=int(e["address"]), count=int(e.get("count", 1)),
-                      type=str(e.get("type") or ("bool" if bit else "uint16")), scale=float(e.get("scale") or 1.0),
-                      unit=str(e.get("unit") or ""), min=None if e.get("min") is None else float(e["min"]),
-                      max=None if e.get("max") is None else float(e["max"]),
-                      access=str(e.get("access") or ("rw" if e["table"] in WRITABLE_TABLES else "r")),
-                      description=str(e.get("description") or ""), choices=tuple(e.get("choices") or ()))
-    except (TypeError, ValueError) as exc:
-        raise MapError(f"{where}: entry {i} ({e.get('name')!r}): {exc}") from None
-
-
-def _check(s: Signal, value: Any) -> Any:
-    if s.type == "bool":
-        if isinstance(value, bool) or value in (0, 1):
-            return bool(value)
-        raise SignalValueError(s.name, f"needs true or false (1 or 0), not {value!r}")
-    if s.choices and isinstance(value, str):
-        if value not in s.choices:
-            raise SignalValueError(s.name, f"{value!r} is not one of {', '.join(repr(c) for c in s.choices)}")
-        return s.choices.index(value)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-        raise SignalValueError(s.name, f"needs a number, not {value!r}")
-    slack = 1e-9 * max(1.0, abs(s.min or 0.0), abs(s.max or 0.0))  # the map's limits carry 9 decimals: an exact end passes
-    if (s.min is not None and value < s.min - slack) or (s.max is not None and value > s.max + slack):
-        raise ValueOutOfRangeError(s.name, value, s.min, s.max, s.unit)
-    if s.type == "float32":
-        if math.isinf(value) or abs(value) > FLOAT32_MAX:
-            raise ValueOutOfRangeError(s.name, value, -FLOAT32_MAX if s.min is None else s.min,
-                                       FLOAT32_MAX if s.max is None else s.max, s.unit)
-        return value
-    limits = TYPE_LIMITS.get(s.type) if s.type != "bool" else None
-    if limits is not None:  # the type's own range, for entries without min or max
-        if math.isinf(value):
-            raise SignalValueError(s.name, f"needs a finite number, not {value!r}")
-        counts = value / s.scale
-        if s.scale == 1.0 and counts != int(counts):
-            raise SignalValueError(s.name, f"needs a whole number ({s.type}), not {value!r}")
-        lo_c, hi_c = limits
-        if not lo_c <= round(counts) <= hi_c:
-            lo = s.min if s.min is not None else _eng(lo_c * s.scale)
-            hi = s.max if s.max is not None else _eng(hi_c * s.scale)
-            raise ValueOutOfRangeError(s.name, value, lo, hi, s.unit)
-    return value
-
-
-def _eng(v: float) -> float | int:
-    return int(v) if float(v).is_integer() else v
-
-
 # -- encode / decode: the server's own (twin.modbus.register_map.Entry), in engineering units ---------------
 def encode(s: Signal, value: Any) -> list:
     """Engineering value (checked) -> register words, or [bit] for the bit tables."""
     if s.choices and not isinstance(value, str):
         value = s.choices[int(value)]
-    words = s.encode(value)
+    words = s.encode(value, engineering=True)
     return [bool(w) for w in words] if s.table in BIT_TABLES else words
 
 
@@ -256,7 +97,7 @@ def plan_reads(signals: Iterable[Signal], mapped: Mapping[str, set[int]] | None 
     too, so L2.actual and L2.force with L5.actual between them still take one request."""
     runs: list[_Run] = []
     for s in sorted(set(signals), key=lambda s: (TABLES.index(s.table), s.address)):
-        limit = MAX_BITS if s.table in BIT_TABLES else MAX_REGISTERS
+        limit = MAX_READ_BITS if s.table in BIT_TABLES else MAX_READ_REGISTERS
         last = runs[-1] if runs else None
         joins = last is not None and last.table == s.table and max(last.end, s.address + s.count) - last.start <= limit and (
             s.address <= last.end or (mapped is not None and all(a in mapped.get(s.table, ()) for a in range(last.end, s.address))))
@@ -293,7 +134,7 @@ class WindowImage:
 class TwinClient:
     """A connection to a twin server, signals by name (see the module's docstring)."""
 
-    def __init__(self, register_map: RegisterMap, host: str = "127.0.0.1", port: int = 5020, unit_id: int = 1,
+    def __init__(self, register_map: RegisterMap, host: str = "127.0.0.1", port: int = DEFAULT_PORT, unit_id: int = 1,
                  timeout: float = 3.0, *, tls: TlsFiles | None = None, heartbeat: float | str | None = "auto"):
         self.map, self.host, self.port, self.unit_id, self.timeout = register_map, host, int(port), int(unit_id), timeout
         self.tls = tls
@@ -311,11 +152,11 @@ class TwinClient:
                 map: str | Path | RegisterMap | None = None, station: str | Path | None = None, timeout: float = 3.0,
                 tls: TlsFiles | None = None, heartbeat: float | str | None = "auto") -> "TwinClient":
         """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`.
-        `tls`: Modbus/TCP Security with these certificate files (port default 802, else 5020).
+        `tls`: Modbus/TCP Security with these certificate files (port default 802, else 5020: `twin.modbus.protocol`).
         `heartbeat`: see `TwinClient` (a request at least that often, so the server's watchdog sees a quiet
         but healthy PLC)."""
         if port is None:
-            port = 802 if tls is not None else 5020
+            port = TLS_PORT if tls is not None else DEFAULT_PORT
         if isinstance(map, RegisterMap):
             rmap = map
         elif map is not None:
@@ -397,7 +238,7 @@ class TwinClient:
             if exc.code != 2:
                 raise
             raise MapError(f"the server at {self.host}:{self.port} serves another register map than the one "
-                           f"given{given}: it has no {MAP_CRC} at input register {self.map[MAP_CRC].address} "
+                           f"given{given}: it has no {MAP_CRC} at input register {lookup(self.map, MAP_CRC).address} "
                            "(an older twin serve?); take the map from the server's station: --station DIR, "
                            "or `twin map STATION --format json`") from None
         if theirs != ours:
@@ -465,14 +306,13 @@ class TwinClient:
         if getattr(self, "_layout", None) is None:
             from twin.modbus.pdu import ImageLayout
 
-            sizes = {t: max((s.address + s.count for s in self.map if s.table == t), default=0) for t in TABLES}
-            self._layout = ImageLayout(sizes)
+            self._layout = ImageLayout({t: self.map.size(t) for t in TABLES})
         return self._layout
 
     @property
     def windows_fit(self) -> bool:
         """The whole input window fits one read (125 registers) and the output window one function 23 write."""
-        return self.layout.in_size <= MAX_REGISTERS and 0 < self.layout.out_size <= MAX_RW_WRITE
+        return self.layout.in_size <= MAX_READ_REGISTERS and 0 < self.layout.out_size <= MAX_RW_WRITE
 
     def read_window(self) -> "WindowImage":
         """The whole input window in one request (function 3)."""
@@ -494,7 +334,7 @@ class TwinClient:
             raise PlcClientError("the output window cannot be filled from the last image")
         start, block = words
         n = self.layout.in_size
-        r = self._call(23, "readwrite_registers", IMAGE_OUT + start, n, [self.map[k] for k in values],
+        r = self._call(23, "readwrite_registers", IMAGE_OUT + start, n, check_names(self.map, values),
                        read_address=IMAGE_IN, read_count=n, write_address=IMAGE_OUT + start, values=block)
         return WindowImage(self, list(r.registers))
 
@@ -503,7 +343,7 @@ class TwinClient:
         from twin.modbus.pdu import IMAGE_OUT
 
         start, block = self._out_words(values, image, 0)
-        self._call(16, "write_registers", IMAGE_OUT + start, len(block), [self.map[k] for k in values], block)
+        self._call(16, "write_registers", IMAGE_OUT + start, len(block), check_names(self.map, values), block)
 
     def _out_words(self, values: Mapping[str, Any], image: "WindowImage", advance: int):
         """(first word, words) of the output window covering `values` (and sim.advance), the words between
@@ -511,13 +351,13 @@ class TwinClient:
         lay = self.layout
         mine: dict[int, int] = {}
         for name, value in values.items():
-            s = self.map[name]
+            s = lookup(self.map, name)
             k, n = lay.out_words(s)
-            ws = [int(w) for w in encode(s, self.map.check_value(name, value))]
+            ws = [int(w) for w in encode(s, check_value(self.map, name, value))]
             for i in range(n):
                 mine[k + i] = ws[i]
         if advance:
-            s = self.map[ADVANCE]
+            s = lookup(self.map, ADVANCE)
             mine[lay.out_words(s)[0]] = int(advance)
         lo, hi = min(mine), max(mine)
         if hi - lo + 1 > MAX_RW_WRITE:
@@ -532,7 +372,7 @@ class TwinClient:
         none); on the wire it is the index into `choices` (`plc read` prints both: `1  (ring)`)."""
         if len(names) == 1 and not isinstance(names[0], str):
             names = tuple(names[0])
-        signals = self.map.check_names(names)
+        signals = check_names(self.map, names)
         values = self.read_signals(signals)
         return {n: values[n] for n in names}
 
@@ -545,7 +385,7 @@ class TwinClient:
         goes last, in a request of its own, once every other write of the call has been answered: in
         lockstep, `write(L2=320.0, **{"sim.advance": 10})` runs the 10 steps with L2 already set."""
         items = dict(values or {}, **more)
-        checked = [(self.map[n], self.map.check_value(n, v)) for n, v in items.items()]
+        checked = [(lookup(self.map, n), check_value(self.map, n, v)) for n, v in items.items()]
         last = [(s, v) for s, v in checked if s.name == ADVANCE]
         checked = [(s, v) for s, v in checked if s.name != ADVANCE]
         by_table: dict[str, list[tuple[Signal, list]]] = {}
@@ -577,7 +417,7 @@ class TwinClient:
         """Read `names` every `interval` s (against the wall clock): yields (s since the first read, values).
         Endless unless `count` is given: stop by breaking out of the loop."""
         names = list(names)
-        self.map.check_names(names)
+        check_names(self.map, names)
         t0 = time.monotonic()
         n = 0
         while count is None or n < count:
@@ -646,7 +486,7 @@ class ClientIO(LocalSignals):
             return {}
         if not self.exchange:
             return self.client.read(*names)
-        signals = self.client.map.check_names(names)
+        signals = check_names(self.client.map, names)
         if not self._fresh or self._image is None:
             self._image = self.client.read_window()
         self._fresh = self.lockstep  # real time: the next scan reads anew; lockstep: until the next advance
@@ -657,7 +497,7 @@ class ClientIO(LocalSignals):
             self.client.write(values)
             return
         for name, value in values.items():
-            self.client.map.check_value(name, value)  # refused here, at the scan that set it
+            check_value(self.client.map, name, value)  # refused here, at the scan that set it
         if ADVANCE in values or self._image is None:
             self.client.write(values)
             self._fresh = False

@@ -1,32 +1,37 @@
 """Errors of the PLC client. Raised where the problem is found; the CLI shows them once, as one line.
 
-    PlcClientError                 base of everything the client raises on purpose
-    ├── MapError                   the register map cannot be loaded (names the file)
-    ├── UnknownSignalError         a name the map does not have ("did you mean ...?")
-    ├── SignalValueError           a value a signal cannot take
-    │   ├── ValueOutOfRangeError   outside the signal's range (names signal, value and range)
-    │   └── NotWritableError       the signal is an output of the twin
-    ├── ModbusExceptionError       the server answered with a Modbus exception (code, address, unit)
-    ├── ConnectionFailedError      no server at host:port, or the connection broke
-    └── OutputRefusedError         a scan cycle's logic set an output the process refused (names it)
+    TwinError (twin.core.errors)       base of everything gripper-twin raises on purpose: catch it for all
+    ├── MapError                       the register map cannot be loaded (names the file and the entry), or
+    │                                  the server serves another map; defined once, in
+    │                                  twin.modbus.register_map (`twin map`'s and the server's too),
+    │                                  re-exported here
+    └── PlcClientError                 base of everything else the client raises on purpose
+        ├── UnknownSignalError         a name the map does not have ("did you mean ...?")
+        ├── SignalValueError           a value a signal cannot take
+        │   ├── ValueOutOfRangeError   outside the signal's range (names signal, value and range)
+        │   └── NotWritableError       the signal is an output of the twin
+        ├── ModbusExceptionError       the server answered with a Modbus exception (code, address, unit)
+        ├── ConnectionFailedError      no server at host:port, or the connection broke
+        └── OutputRefusedError         a scan cycle's logic set an output the process refused (names it)
+
+`except TwinError` catches both branches (the `plc` command does that: one line, exit status 2, or 1 for
+a connection or a Modbus exception); `except PlcClientError` no longer catches a MapError.
 """
 from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
 
-# Modbus exception codes (the application protocol specification, section 7)
-EXCEPTION_NAMES = {1: "illegal function", 2: "illegal data address", 3: "illegal data value",
-                   4: "server device failure", 5: "acknowledge", 6: "server device busy",
-                   8: "memory parity error", 10: "gateway path unavailable", 11: "gateway target failed to respond"}
+from twin.core.errors import TwinError
+from twin.modbus.protocol import EXCEPTION_NAMES
+from twin.modbus.register_map import MapError
+
+__all__ = ["TwinError", "MapError", "PlcClientError", "UnknownSignalError", "SignalValueError", "ValueOutOfRangeError",
+           "NotWritableError", "ModbusExceptionError", "ConnectionFailedError", "OutputRefusedError", "EXCEPTION_NAMES"]
 
 
-class PlcClientError(Exception):
-    """Base class of the PLC client's errors."""
-
-
-class MapError(PlcClientError):
-    """A register map file or station cannot be read."""
+class PlcClientError(TwinError):
+    """Base class of the PLC client's own errors (a MapError is a TwinError beside it: see the tree above)."""
 
 
 class UnknownSignalError(PlcClientError, KeyError):

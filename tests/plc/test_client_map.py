@@ -3,6 +3,7 @@ import json
 
 import pytest
 
+from plc_client.checks import check_value, lookup
 from plc_client.client import RegisterMap, decode, encode, plan_reads
 from plc_client.errors import MapError, NotWritableError, SignalValueError, UnknownSignalError, ValueOutOfRangeError
 
@@ -28,21 +29,21 @@ def rmap(tmp_path):
 
 def test_a_misspelt_name_gets_a_suggestion(rmap):
     with pytest.raises(UnknownSignalError, match=r"unknown signal 'L2.actul'; did you mean 'L2.actual'\?"):
-        rmap["L2.actul"]
+        lookup(rmap, "L2.actul")
 
 
 def test_a_value_outside_the_range_names_the_signal_and_the_range(rmap):
     with pytest.raises(ValueOutOfRangeError, match=r"signal 'L2': 500 mm is out of range: 0 to 441 mm"):
-        rmap.check_value("L2", 500)
+        check_value(rmap, "L2", 500)
 
 
 def test_outputs_and_wrong_kinds_of_value_are_refused_before_the_wire(rmap):
     with pytest.raises(NotWritableError, match="doGripped"):
-        rmap.check_value("doGripped", True)
+        check_value(rmap, "doGripped", True)
     with pytest.raises(SignalValueError, match="needs a number"):
-        rmap.check_value("L2", "fast")
+        check_value(rmap, "L2", "fast")
     with pytest.raises(SignalValueError, match="true or false"):
-        rmap.check_value("Active", 2)
+        check_value(rmap, "Active", 2)
 
 
 @pytest.mark.parametrize("name, value", [("L2", 320.5), ("L2.actual", -12.34), ("L2.force", 1499.5), ("GrippedPart", "ring"),
@@ -114,21 +115,21 @@ def typed():
 ])
 def test_a_value_outside_the_types_range_is_refused_for_entries_without_min_or_max(typed, name, value, message):
     with pytest.raises(ValueOutOfRangeError, match=message):
-        typed.check_value(name, value)
+        check_value(typed, name, value)
 
 
 def test_a_fraction_for_a_whole_number_entry_is_refused_not_rounded(typed):
     with pytest.raises(SignalValueError, match=r"signal 'goMisses': needs a whole number \(int32\), not 3.5"):
-        typed.check_value("goMisses", 3.5)
+        check_value(typed, "goMisses", 3.5)
     with pytest.raises(SignalValueError, match="whole number"):
-        typed.check_value("sim.advance", 2.5)
+        check_value(typed, "sim.advance", 2.5)
     with pytest.raises(SignalValueError, match="needs a number"):
-        typed.check_value("aoFingerReady", float("nan"))
+        check_value(typed, "aoFingerReady", float("nan"))
     # what fits goes through: the type's limits, whole floats, fractions where the scale resolves them
     for name, value in [("goMisses", 3.0), ("goMisses", -2 ** 31), ("count", 2 ** 32 - 1), ("small", -32768),
                         ("word", 65535), ("fine", 12.34), ("aoFingerReady", 3.4e38), ("aoFingerReady", -150.5)]:
         s = typed[name]
-        assert decode(s, encode(s, typed.check_value(name, value))) == pytest.approx(value, rel=1e-6)
+        assert decode(s, encode(s, check_value(typed, name, value))) == pytest.approx(value, rel=1e-6)
 
 
 # -- sim.advance goes last -----------------------------------------------------------------------------------

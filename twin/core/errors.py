@@ -7,6 +7,9 @@
     │   ├── SignalTypeError   a value of the wrong type for the signal (text for a number, NaN, ...)
     │   └── SignalRangeError  a value outside the signal's range (never clamped)
     └── MotionError           the robot cannot reach a target (names the target)
+
+Above the core, `twin.modbus.register_map.MapError` and `plc_client.errors.PlcClientError` derive from
+`TwinError` too: `except TwinError` catches everything gripper-twin raises on purpose.
 """
 from __future__ import annotations
 

@@ -21,8 +21,7 @@ import sys
 from pathlib import Path
 
 from .log import LEVELS, log as _log
-
-MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT = 64, 400, 802  # as twin.modbus.server (not imported: start-up speed)
+from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT
 
 
 def _positive(text: str) -> float:
@@ -91,7 +90,7 @@ def add_commands(subparsers, cmd_serve):
 def add_serve_arguments(p) -> None:
     """The Modbus front end's flags of `twin serve` (and the runner's: --realtime/--lockstep, --speed)."""
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback only)")
-    p.add_argument("--port", type=_port, default=5020, help="TCP port (default 5020; 0 = any free port, printed)")
+    p.add_argument("--port", type=_port, default=DEFAULT_PORT, help=f"TCP port (default {DEFAULT_PORT}; 0 = any free port, printed)")
     p.add_argument("--unit-id", type=_unit, default=None,
                    help="Modbus unit id answered (default 1; 0 and 255 too); with --profile: the profile's unit id "
                         "(default: every unit id but --map-unit-id)")

@@ -18,15 +18,14 @@ from twin.core.errors import StationError, TwinError
 
 from .bridge import TwinBridge
 from .log import log as _log
-from .server import MAX_CONNECTIONS, REQUESTS_PER_STEP, ModbusServer
-
-TLS_PORT = 802
+from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT
+from .server import ModbusServer
 
 
 class ModbusFrontEnd:
     name = "modbus"
 
-    def __init__(self, *, host: str = "127.0.0.1", port: int = 5020, unit_id: int | None = None,
+    def __init__(self, *, host: str = "127.0.0.1", port: int = DEFAULT_PORT, unit_id: int | None = None,
                  frame_timeout: float = 1.0, requests_per_step: int = REQUESTS_PER_STEP,
                  max_connections: int = MAX_CONNECTIONS, idle_timeout: float = 0.0, allow=None,
                  read_only: bool = False, gaps: str = "error", watchdog: float | None = None, tls=None,

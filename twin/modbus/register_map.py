@@ -1,8 +1,11 @@
 """The Modbus register map: derived from a station's signal table, never written by hand.
 
 `build_register_map(signals)` is a pure function of the signal table (`twin.core.signals.SignalSpec`,
-in the station's declaration order). The one frozen `RegisterMap` it returns feeds the server, the
-json/csv/md exports (`twin map`) and the PLC client's name lookup.
+in the station's declaration order). The frozen `RegisterMap` it returns is the one map type of the
+project: it feeds the server, the json/csv/md exports (`twin map`) and the PLC client, which loads the
+same type from a station (`RegisterMap.from_station`, no physics) or from `twin map --format json`
+output (`RegisterMap.from_json`). A map that cannot be built or loaded raises `MapError` (a `TwinError`)
+naming the signal, or the file and the entry's index.
 
 Layout (addresses are 0-based protocol addresses):
 
@@ -47,11 +50,16 @@ import struct
 import zlib
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
+from functools import cached_property
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
 
 from twin.core.signal_table import (SIM_ADVANCE as ADVANCE, SIM_DT_US as DT_US, SIM_FAULT as FAULT,
                                     SIM_LATE as LATE, SIM_LATE_STEPS as LATE_STEPS, SIM_LOCKSTEP as LOCKSTEP,
                                     SIM_MAP_CRC as MAP_CRC, SIM_MODE as MODE, SIM_SIGNALS, SIM_SPEED_PCT as SPEED_PCT,
                                     SIM_STEP as STEP, SIM_TIME_MS as TIME_MS, WATCHDOG_MS, station_signals)
+from twin.core.errors import TwinError
 from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
 from twin.core.station import load_station
 
@@ -79,8 +87,12 @@ UNITS = {
 
 
 
-class MapError(ValueError):
-    """The signal table cannot be turned into a register map (e.g. a duplicate name)."""
+class MapError(TwinError, ValueError):
+    """A register map cannot be built or loaded: a signal table that does not fit (a duplicate name, a full
+    table), a map file that cannot be read or is not `twin map --format json` output (the message names the
+    file and the entry's index), a station whose map cannot be derived, or (raised by the PLC client) a
+    server that serves another map than the one given. The one map error of the project: `plc_client`
+    re-exports it."""
 
 
 def map_crc(entries: Iterable) -> int:
@@ -144,9 +156,10 @@ class Entry:
         return lo, hi
 
     # -- engineering value <-> words ------------------------------------------------------------------
-    def counts_of(self, value) -> int | float:
+    def counts_of(self, value, *, engineering: bool = False) -> int | float:
         """SI value (as the twin reads it) -> counts (an output saturated at its declared range, anything at its
-        type's limits)."""
+        type's limits). `engineering`: the value is in the entry's `unit` already (mm, deg: as a PLC holds it)."""
+        factor = 1.0 if engineering else self.factor
         if self.type == "bool":
             return 1 if value else 0
         if self.choices:
@@ -156,8 +169,8 @@ class Entry:
         if isinstance(value, bool):
             value = int(value)
         if self.type == "float32":
-            return float(value) * self.factor
-        v = float(value) * self.factor / self.scale
+            return float(value) * factor
+        v = float(value) * factor / self.scale
         if math.isnan(v):
             return 0
         lo, hi = TYPE_LIMITS[self.type]
@@ -168,9 +181,10 @@ class Entry:
                 hi = min(hi, math.floor(self.max / self.scale + 1e-9))
         return lo if v <= lo else hi if v >= hi else int(round(v))
 
-    def encode(self, value) -> list[int]:
-        """SI value -> register words (big-endian, high word first), or [0/1] for a bit."""
-        c = self.counts_of(value)
+    def encode(self, value, *, engineering: bool = False) -> list[int]:
+        """SI value -> register words (big-endian, high word first), or [0/1] for a bit. `engineering`: the
+        value is in the entry's `unit` (what `decode` gives back), as a client or a PLC holds it."""
+        c = self.counts_of(value, engineering=engineering)
         if self.type in ("bool", "uint16"):
             return [c]
         if self.type == "int16":
@@ -227,14 +241,80 @@ class Entry:
 
 @dataclass(frozen=True)
 class RegisterMap:
-    """All entries, grouped by table in address order. Built by `build_register_map`."""
+    """All entries, by name. Built by `build_register_map` (grouped by table in address order), or loaded:
+    `from_station` (the map `twin serve` serves, without physics) and `from_json` (`twin map --format json`
+    output, in its order).
+
+    `source` says where the map came from, for messages (a file, or "station 'NAME'"); `meta` holds what a
+    json map carries beside its entries. Neither takes part in comparing maps."""
 
     entries: tuple[Entry, ...]
     station: str = ""
+    source: str = field(default="", compare=False)
+    meta: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
     by_name: Mapping[str, Entry] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         object.__setattr__(self, "by_name", {e.name: e for e in self.entries})
+        object.__setattr__(self, "meta", MappingProxyType(dict(self.meta)))
+
+    # -- loading --------------------------------------------------------------------------------------
+    @classmethod
+    def from_station(cls, station) -> "RegisterMap":
+        """The map `twin serve` serves for a station (a folder or a station.toml), from its static signal
+        table: no physics, no RAPID. A station that cannot be read is a MapError too (naming its file and
+        key, chained to the core's StationError), so a client has one error for "no map"."""
+        try:
+            built = build_map(station)
+        except MapError:
+            raise
+        except TwinError as exc:
+            raise MapError(str(exc)) from exc
+        return cls(built.entries, built.station, source=f"station {built.station!r}")
+
+    @classmethod
+    def from_json(cls, source: str | Path | Mapping | list) -> "RegisterMap":
+        """From `twin map --format json` output: a file path, its text, or the parsed data (a list of
+        entries, or an object with them under "signals", "entries" or "registers"; its other keys become
+        `meta`, its "station" the map's station). Values are in the entries' engineering units (a json map
+        has no SI factor). Anything that is not such a map is a MapError naming the file and the entry."""
+        where = ""
+        if isinstance(source, Path) or (isinstance(source, str) and not source.lstrip().startswith(("{", "["))):
+            where = str(source)
+            try:
+                source = Path(source).read_text(encoding="utf-8")
+            except (OSError, UnicodeDecodeError) as exc:
+                raise MapError(f"{where}: cannot read the register map: {getattr(exc, 'strerror', None) or exc}") from None
+        label = where or "register map"
+        if isinstance(source, (bytes, bytearray)):
+            source = source.decode("utf-8", errors="replace")
+        if isinstance(source, str):
+            try:
+                source = json.loads(source)
+            except json.JSONDecodeError as exc:
+                raise MapError(f"{label}: not JSON (line {exc.lineno}: {exc.msg}); "
+                               f"make one with `twin map STATION --format json`") from None
+        data, meta = source, {}
+        if isinstance(data, Mapping):
+            meta = {k: v for k, v in data.items() if k not in ("signals", "entries", "registers")}
+            data = data.get("signals", data.get("entries", data.get("registers")))
+        if not isinstance(data, list):
+            raise MapError(f"{label}: expected a list of entries (the output of `twin map STATION --format json`)")
+        entries, seen = [], {}
+        for i, item in enumerate(data):
+            e = _entry_from_dict(item, label, i)
+            if e.name in seen:
+                raise MapError(f"{label}: entry {i} ({e.name!r}): the name appears twice (entry {seen[e.name]} too)")
+            seen[e.name] = i
+            entries.append(e)
+        station = meta.get("station")
+        return cls(tuple(entries), station if isinstance(station, str) else "", source=where, meta=meta)
+
+    @cached_property
+    def mapped(self) -> Mapping[str, frozenset[int]]:
+        """Per table, every address some entry covers (a read across these answers; others get exception 02)."""
+        return MappingProxyType({t: frozenset(a for e in self.entries if e.table == t for a in range(e.address, e.end))
+                                 for t in TABLES})
 
     @property
     def crc(self) -> int:
@@ -312,6 +392,48 @@ class RegisterMap:
                              f"{desc.replace('|', '/')} |")
             lines.append("")
         return "\n".join(lines)
+
+
+def _entry_from_dict(e: Any, where: str, i: int) -> Entry:
+    """One entry of a json map (as `Entry.as_dict` writes it; type, count, access have defaults by table)."""
+    if not isinstance(e, Mapping) or not all(k in e for k in ("name", "table", "address")):
+        raise MapError(f"{where}: entry {i} needs at least name, table and address")
+    name, table = e["name"], e["table"]
+
+    def bad(message: str) -> MapError:
+        return MapError(f"{where}: entry {i} ({name!r}): {message}")
+
+    if table not in TABLES:
+        raise bad(f"unknown table {table!r} (one of {', '.join(TABLES)})")
+    bit = table in BIT_TABLES
+    try:
+        type_ = str(e.get("type") or ("bool" if bit else "uint16"))
+        if type_ not in WIDTH:
+            raise bad(f"unknown type {type_!r} (one of {', '.join(WIDTH)})")
+        if bit != (type_ == "bool"):
+            raise bad(f"a {table} holds {'bools' if bit else 'words'}, not {type_}")
+        entry = Entry(name=str(name), table=table, address=int(e["address"]), count=int(e.get("count") or WIDTH[type_]),
+                      type=type_, scale=float(e.get("scale") or 1.0), unit=str(e.get("unit") or ""),
+                      min=None if e.get("min") is None else float(e["min"]),
+                      max=None if e.get("max") is None else float(e["max"]),
+                      access=str(e.get("access") or ("rw" if table in (COIL, HOLDING_REGISTER) else "r")),
+                      description=str(e.get("description") or ""), choices=tuple(str(c) for c in e.get("choices") or ()))
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, MapError):
+            raise
+        raise bad(str(exc)) from None
+    if entry.count != WIDTH[type_]:
+        raise bad(f"a {type_} takes {WIDTH[type_]} {'bit' if bit else 'register'}{'s' if WIDTH[type_] > 1 else ''}, "
+                  f"not count {entry.count}")
+    if not (0 <= entry.address and entry.end <= 0x10000):
+        raise bad(f"address {entry.address} is outside 0..65535")
+    if entry.access not in ("r", "rw") or (entry.access == "rw" and table not in (COIL, HOLDING_REGISTER)):
+        raise bad(f"access {entry.access!r}: 'r', or 'rw' in the coils and holding registers")
+    if not entry.scale > 0:
+        raise bad(f"scale {entry.scale:g} must be greater than 0")
+    if entry.min is not None and entry.max is not None and entry.min > entry.max:
+        raise bad(f"min {entry.min:g} is above max {entry.max:g}")
+    return entry
 
 
 def _num(v):

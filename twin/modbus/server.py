@@ -78,17 +78,15 @@ from collections.abc import Callable, Iterable
 from .log import log as _log
 from .pdu import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
                   SERVER_DEVICE_FAILURE, Backend, Deferred, DeviceIdentity, Images, PduHandler)
+from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT  # noqa: F401
 from .register_map import RegisterMap
 
 MAX_LENGTH = 1 + 10 + 2 * 127  # MBAP length: unit id + function 23 writing 127 registers (byte count 254)
-REQUESTS_PER_STEP = 400  # global budget: requests answered per step period, over all connections
 SERVE_SHARE = 0.5  # at most this share of a step period's wall time goes to answering requests
 MIN_SCALE = 1 / 16  # however late the simulation, a period still answers this share of the budget
 TURN_SECONDS = 0.002  # one turn of answering gives the loop back after this long
 QUANTUM = 32  # requests of one connection answered in a row before the next connection's turn
-MAX_CONNECTIONS = 64
 READ_BACKLOG = 16384  # bytes buffered per connection before it is no longer read
-TLS_PORT = 802  # Modbus/TCP Security's registered port (mbap/TLS)
 
 _HDR = struct.Struct(">HHHB")
 
@@ -157,7 +155,7 @@ class ModbusServer:
     def requests(self) -> int:
         return self.pdus.requests
 
-    async def start(self, host: str = "127.0.0.1", port: int = 5020, *, ssl: ssl.SSLContext | None = None) -> tuple[str, int]:
+    async def start(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, *, ssl: ssl.SSLContext | None = None) -> tuple[str, int]:
         """Listen on host:port (plain Modbus/TCP, or Modbus/TCP Security with `ssl`); may be called for both."""
         loop = asyncio.get_running_loop()
         kw = {"ssl": ssl, "ssl_handshake_timeout": max(1.0, 5 * self.frame_timeout)} if ssl is not None else {}
