@@ -24,7 +24,7 @@ SPEC = """
 name = "bench"
 station = "{station}"
 [driver]
-plc = "plc_client.ring_rig:sequence"
+plc = "stations.ring_rig_plc.plc_logic:sequence"
 scan = 0.012
 [start]
 grip_request = true

@@ -5,7 +5,7 @@ ratio measured in one run.
     python -m bench cell [--cycles N]
 
 Both runs use `stations/ring_rig_plc` (physics, the RAPID robot controller and the grip sequence) and the
-same PLC program (`plc_client.ring_rig.cell_sequence` and the demo's operator), scanning every 10 ms.
+same PLC program (`stations.ring_rig_plc.plc_logic.cell_sequence` and the demo's operator), scanning every 10 ms.
 Over Modbus the PLC exchanges its process image through the server's process-image windows: one function
 23 per scan (outputs and sim.advance written, inputs read once the steps are done). Besides the wall
 time, which a loaded machine inflates for the two-process run (every scan waits for both processes to be
@@ -22,8 +22,8 @@ STATION = ROOT / "stations" / "ring_rig_plc"
 
 
 def in_process(cycles: int) -> dict:
-    from plc_client import ring_rig
-    from plc_client.cell_demo import operator
+    from stations.ring_rig_plc import plc_logic as ring_rig
+    from stations.ring_rig_plc.demo import operator
     from plc_client.scan import Combined, ScanCycle, TwinIO
     from twin_app.cell import open_cell
 
@@ -41,7 +41,7 @@ def in_process(cycles: int) -> dict:
 
 
 def across_the_network(cycles: int) -> dict:
-    from plc_client.cell_demo import CellDemo
+    from stations.ring_rig_plc.demo import CellDemo
 
     demo = CellDemo(STATION, cycles, out=lambda line: None)
     t0 = time.perf_counter()

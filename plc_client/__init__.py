@@ -16,3 +16,5 @@ __all__ = ["TwinClient", "RegisterMap", "Signal", "ClientIO", "ScanCycle", "Comb
            "Handshake", "Phase", "Fault", "PlcClientError", "MapError", "UnknownSignalError", "SignalValueError",
            "ValueOutOfRangeError", "NotWritableError", "ModbusExceptionError", "ConnectionFailedError",
            "OutputRefusedError"]
+
+import twin as _twin  # noqa: E402,F401  installs twin.moved's finder: old import paths of station code that moved

@@ -8,12 +8,14 @@
         watch NAME... [--interval S] [--count N]   a live view (one redrawn line on a terminal)
         run MODULE:NAME [--cycle S] [--seconds S | --scans N] [--speed X]   run PLC logic on a scan cycle
         map                               the signals it knows: table, address, type, unit, range, access
-    plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE]   the main job (plc_client.cell_demo)
+        run [--station DIR]               the PLC logic the station names ([plugins] plc_logic)
+    plc demo [--station DIR] [OPTIONS]    a station's demo ([plugins] plc_demo in its station.toml; without
+                                          --station, the shipped station that has one: the main job)
 
-E.g. the cell's gripper PLC against `twin serve stations/ring_rig_plc --port 5020 --lockstep`:
-    plc --station stations/ring_rig_plc run plc_client.ring_rig:cell_sequence
+E.g. a station's gripper PLC against `twin serve STATION --port 5020 --lockstep`:
+    plc --station STATION run my_plc.py:gripper_plc
 
-The global options may also follow the command (`plc read L2 --port 5021`). Data goes to stdout; a
+The global options may also follow the command (`plc read axis1 --port 5021`). Data goes to stdout; a
 problem is one line on stderr, `plc: error: ...`, with exit status 2 for a user error (unknown name, bad
 value, bad map, a map that is not the one the server serves) and 1 when the server cannot be reached or
 refuses a request, or when `plc run`'s logic sets an output the server refuses.
@@ -97,9 +99,9 @@ def build_parser() -> argparse.ArgumentParser:
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_watch)
     p = sub.add_parser("run", help="run PLC logic (module:name or file.py:name) on a scan cycle against the server")
-    p.add_argument("target", metavar="MODULE:NAME", help="a logic with .inputs (e.g. a GripSequence), or a function "
-                   "without arguments that returns one, e.g. plc_client.ring_rig:cell_sequence (the gripper PLC "
-                   "of stations/ring_rig_plc)")
+    p.add_argument("target", metavar="MODULE:NAME", nargs="?", default=None,
+                   help="a logic with .inputs (e.g. a GripSequence), or a function without arguments that returns one "
+                   "(package.module:name or file.py:name); default: the one the --station names in its [plugins] plc_logic")
     p.add_argument("--cycle", type=positive_float, default=0.010, help="scan cycle, s (default 0.010)")
     bound = p.add_mutually_exclusive_group()
     bound.add_argument("--seconds", type=positive_float, default=None, help="stop after this much PLC time")
@@ -117,9 +119,23 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("map", help="the signals the map knows: table, address, type, unit, range, access")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_map)
-    from .cell_demo import add_command
-    add_command(sub)
+    p = sub.add_parser("demo", add_help=False, help="a station's demo (its station.toml's [plugins] plc_demo); "
+                       "without --station, the shipped one: the main job (`plc demo --help` lists its options)")
+    p.set_defaults(func=cmd_demo, takes_options=True)
     return parser
+
+
+def cmd_demo(args) -> int:
+    from twin.core.errors import TwinError
+    from twin.plugins import run_station_demo
+
+    try:
+        options = args.demo_options
+        if args.station and not any(o == "--station" or o.startswith("--station=") for o in options):
+            options = ["--station", args.station, *options]  # `plc --station DIR demo`
+        return run_station_demo("plc_demo", options, prog="plc demo", parser_class=Parser, positional=False)
+    except TwinError as exc:
+        raise UsageError(str(exc)) from None
 
 
 # -- commands ---------------------------------------------------------------------------------------------
@@ -245,8 +261,8 @@ def load_logic(target: str):
 
 def check_logic_signals(target: str, logic, rmap: RegisterMap) -> None:
     """Every signal the logic reads or writes must be in the map: else one error naming the logic and all
-    the missing names (e.g. the generic handshake names of `ring_rig:sequence` against a station whose
-    robot program uses its own, where `ring_rig:cell_sequence` is the one that fits)."""
+    the missing names (e.g. a logic on generic handshake names against a station whose robot program uses
+    its own names)."""
     inputs = [n for n in logic.inputs if n not in rmap]
     outputs = [n for n in getattr(logic, "outputs", ()) if n not in rmap and n not in inputs]
     if not inputs and not outputs:
@@ -261,11 +277,33 @@ def check_logic_signals(target: str, logic, rmap: RegisterMap) -> None:
                      "(is it the logic for this station?)")
 
 
+def station_logic(args) -> str:
+    """`plc run` without MODULE:NAME: the PLC logic the station names (`[plugins] plc_logic`), as a reference."""
+    from twin.core.errors import TwinError
+    from twin.core.station import load_station
+
+    if not args.station:
+        raise UsageError("run needs MODULE:NAME (or --station DIR of a station that names its PLC logic)")
+    try:
+        st = load_station(args.station)
+    except TwinError as exc:
+        raise UsageError(str(exc)) from None
+    ref = st.plugins.get("plc_logic")
+    if ref is None:
+        raise UsageError(f"{st.file}: names no PLC logic ([plugins] plc_logic): give MODULE:NAME")
+    where, sep, attr = ref.rpartition(":")
+    if sep and where.endswith(".py"):
+        ref = f"{(st.folder / where)}:{attr}"
+    return ref
+
+
 def cmd_run(args) -> int:
     from .client import ClientIO
     from .scan import ScanCycle
     from twin.modbus.register_map import SPEED_PCT
 
+    if args.target is None:
+        args.target = station_logic(args)
     logic = load_logic(args.target)
     rmap = load_map(args)
     check_logic_signals(args.target, logic, rmap)
@@ -351,7 +389,9 @@ class UsageError(PlcClientError):
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    from twin.plugins import parse_command_line
+
+    args = parse_command_line(build_parser(), argv)  # a station's demo keeps its own options
     logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # its own log lines would repeat ours
     try:
         return args.func(args)

@@ -2,10 +2,10 @@
 
     from plc_client import TwinClient
 
-    with TwinClient.connect("127.0.0.1", 5020, map="ring_rig.json") as plc:   # or station="stations/ring_rig"
-        plc.write(L2=320.0)                    # mm, as the map publishes prismatic axes
-        plc.read("L2.actual", "L2.force", "doGripped")   # {'L2.actual': 329.9, 'L2.force': 3.1, 'doGripped': False}
-        for t, values in plc.poll(["L2.force"], interval=0.1, count=10): ...
+    with TwinClient.connect("127.0.0.1", 5020, map="my_cell.json") as plc:   # or station="stations/my_cell"
+        plc.write(axis1=320.0)                    # mm, as the map publishes prismatic axes
+        plc.read("axis1.actual", "axis1.force", "doGripped")   # {'axis1.actual': 329.9, 'axis1.force': 3.1, 'doGripped': False}
+        for t, values in plc.poll(["axis1.force"], interval=0.1, count=10): ...
 
 The register map is the server's own type, `twin.modbus.register_map.RegisterMap` (also importable as
 `plc_client.RegisterMap`), loaded from `twin map STATION --format json` output (`RegisterMap.from_json`)
@@ -94,7 +94,7 @@ class _Run:
 def plan_reads(signals: Iterable[Signal], mapped: Mapping[str, set[int]] | None = None) -> list[_Run]:
     """Group signals into requests: contiguous addresses of one table, within the protocol's size limits.
     With `mapped` (the addresses the map covers, per table), a gap of mapped addresses is read through
-    too, so L2.actual and L2.force with L5.actual between them still take one request."""
+    too, so axis1.actual and axis1.force with axis2.actual between them still take one request."""
     runs: list[_Run] = []
     for s in sorted(set(signals), key=lambda s: (TABLES.index(s.table), s.address)):
         limit = MAX_READ_BITS if s.table in BIT_TABLES else MAX_READ_REGISTERS
@@ -227,7 +227,7 @@ class TwinClient:
 
     def _check_map(self) -> None:
         """A map with `sim.map_crc`: the server must publish the same CRC, else it serves another map (a
-        smart_gripper server read with the ring_rig map would give wrong values without a word)."""
+        server of one station read with another station's map would give wrong values without a word)."""
         if MAP_CRC not in self.map:
             return  # a map from before sim.map_crc: nothing to compare
         ours = self.map.crc
@@ -380,10 +380,10 @@ class TwinClient:
         return self.read(name)[name]
 
     def write(self, values: Mapping[str, Any] | None = None, /, **more: Any) -> None:
-        """Write signals by name (`write(L2=320.0)` or `write({"L2.x": 1})`). Everything is checked first:
+        """Write signals by name (`write(axis1=320.0)` or `write({"axis1.x": 1})`). Everything is checked first:
         one bad name or value and nothing is written. Contiguous registers go in one request. `sim.advance`
         goes last, in a request of its own, once every other write of the call has been answered: in
-        lockstep, `write(L2=320.0, **{"sim.advance": 10})` runs the 10 steps with L2 already set."""
+        lockstep, `write(axis1=320.0, **{"sim.advance": 10})` runs the 10 steps with axis1 already set."""
         items = dict(values or {}, **more)
         checked = [(lookup(self.map, n), check_value(self.map, n, v)) for n, v in items.items()]
         last = [(s, v) for s, v in checked if s.name == ADVANCE]

@@ -1,4 +1,4 @@
-"""The demo's report: the run is recorded by the twin server, and the report is drawn from that recording
+"""A demo's report (`plc demo`): the run is recorded by the twin server, and the report is drawn from that recording
 (`twin.report`: the signal plot and a picture of the cell at each grip and release, in one folder).
 
 Without the [view] extra (matplotlib, pyarrow) the demo still runs: it records to CSV, and says in one
@@ -21,7 +21,8 @@ def recording_for(record: str | None, report_dir: str | None) -> str | None:
     return str(Path(report_dir) / "recording.parquet")
 
 
-def report(record: str, report_dir: str, *, threshold: float | None, narration: list[str]) -> Path | None:
+def report(record: str, report_dir: str, *, threshold: float | None, narration: list[str],
+           title: str = "gripper-twin demo") -> Path | None:
     try:
         import matplotlib  # noqa: F401
         import PIL  # noqa: F401
@@ -31,6 +32,6 @@ def report(record: str, report_dir: str, *, threshold: float | None, narration: 
     from twin.report import write_report
 
     index = write_report(record, report_dir, threshold=threshold, narration=narration,
-                         title="gripper-twin demo: the ring rig's automatic cycle")
+                         title=title)
     print(f"report: {index.resolve()}", flush=True)
     return index

@@ -24,7 +24,7 @@ map's engineering units (mm, N); in process, `TwinIO` publishes the same units. 
 edge-triggered requests (a rising edge starts a grip or a release, so the robot may leave the bit set
 until it sees `gripped` or `fault`) and level outputs.
 
-    seq = GripSequence(axes=("L2", "L3", "L4"), forces=("L2.force", "L3.force", "L5.force"),
+    seq = GripSequence(axes=("axis1", "axis2", "axis3"), forces=("axis1.force", "axis2.force", "axis3.force"),
                        speed=20.0, threshold=200.0, end_of_travel={"outside": 290.0, "inside": 230.0})
     ScanCycle(io, seq).run(seconds=5.0)
 """

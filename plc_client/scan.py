@@ -70,9 +70,9 @@ Logic = Callable[[InputImage, Any], Mapping[str, Any]]
 def plc_logic(inputs: Iterable[str], state: Callable[[], Any] | None = None):
     """Declare what a plain logic function reads (and how its state starts), for `ScanCycle` and `plc run`:
 
-        @plc_logic(inputs=["start", "L2.force"])
+        @plc_logic(inputs=["start", "axis1.force"])
         def press(inputs, state):
-            return {"L2": 300.0 if inputs["start"] else 330.0}
+            return {"axis1": 300.0 if inputs["start"] else 330.0}
     """
     def mark(fn):
         fn.inputs = tuple(inputs)
@@ -90,7 +90,7 @@ def _initial_state(logic) -> Any:
 class Combined:
     """Several logics in one PLC program, run in order every scan on the same input image, each with its own
     state; their outputs merge (a later logic wins a shared output). E.g. a cell sequencer beside the grip
-    sequence: `ScanCycle(io, Combined(ring_rig.cell_sequence(), operator))`."""
+    sequence: `ScanCycle(io, Combined(grip_sequence, operator))`."""
 
     def __init__(self, *logics: Logic):
         if not logics:

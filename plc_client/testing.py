@@ -4,20 +4,20 @@ As a context manager, anywhere:
 
     from plc_client.testing import twin_server
 
-    with twin_server("stations/ring_rig", lockstep=True) as server:
+    with twin_server("stations/my_cell", lockstep=True) as server:
         with server.client() as plc:
-            plc.write(L2=320.0); plc.advance(100); assert plc.get("L2.actual") < 330.0
+            plc.write(axis1=320.0); plc.advance(100); assert plc.get("axis1.actual") < 330.0
 
 As pytest fixtures (in your `conftest.py`: `pytest_plugins = ["plc_client.testing"]`, and name the station):
 
     @pytest.fixture
     def plc_station():
-        return "stations/ring_rig"
+        return "stations/my_cell"
 
     def test_fingers_close(twin_client):          # a connected TwinClient; the server is lockstep
-        twin_client.write(L2=320.0)
+        twin_client.write(axis1=320.0)
         twin_client.advance(100)
-        assert twin_client.get("L2.actual") == pytest.approx(320.0, abs=0.5)
+        assert twin_client.get("axis1.actual") == pytest.approx(320.0, abs=0.5)
 
 `plc_server` gives the running server (`.host`, `.port`, `.map`, `.client()`), `plc_lockstep` (default
 True) chooses lockstep or real time. See docs/commissioning-checks.md.

@@ -55,7 +55,7 @@ def parse_io(items: list[str]) -> list[SignalInfo]:
     for item in items:
         for part in filter(None, (p.strip() for p in item.split(","))):
             if ":" not in part:
-                raise UsageError(f"--io {part!r}: expected TYPE:NAME, e.g. DI:diGripped")
+                raise UsageError(f"--io {part!r}: expected TYPE:NAME, e.g. DI:diPartHeld")
             kind, name = (x.strip() for x in part.split(":", 1))
             kind = kind.upper()
             if kind not in SIGNAL_KINDS:
@@ -111,7 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="a module of station data the program expects (tooldata, wobjdata, robtargets); "
                              "repeatable")
         sp.add_argument("--io", action="extend", nargs="+", default=[], metavar="TYPE:NAME,...",
-                        help="configure I/O signals, e.g. DI:diGripped,AO:aoAxis1 (repeatable)")
+                        help="configure I/O signals, e.g. DI:diPartHeld,AO:aoWidth (repeatable)")
         sp.add_argument("--entry", default="main", help="routine to start from (default: main)")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="NAME=VALUE[@T]",
                      help="set a signal at simulated time T seconds (default 0); repeatable")

@@ -27,10 +27,10 @@ its joints).
 
 Notes for a station binding (item 5):
 - `signals()` comes from the station file's controller I/O section (name, type, wiring). The
-  controller reads outputs too (`aoAxis1<=440` reads the AO's present value), so `read_signal`
+  controller reads outputs too (`aoWidth<=440` reads the AO's present value), so `read_signal`
   must answer for every configured signal, outputs included (the last value written).
-- Wiring is the binding's job: `write_signal("aoAxis1", 331)` in mm becomes the gripper input L2 =
-  0.331 m, the way RobotStudio's expression blocks divide by 1000; a DI such as diGripped reads the
+- Wiring is the binding's job: `write_signal("aoWidth", 331)` in mm becomes the gripper input `width` =
+  0.331 m, the way RobotStudio's expression blocks divide by 1000; a DI such as diPartHeld reads the
   twin's grip output. The controller never scales anything.
 - `start_motion` receives targets in mm and quaternions [q1..q4] (q1 = w), in `request.wobj`'s
   user/object frame, for the TCP of `request.tool` (tframe in the flange frame); `motion_done` is

@@ -3,8 +3,8 @@
 Two small adapters, one per side of the controller:
 
 - `TwinHost` is the controller's `Host`. Its I/O signals are the station's `[[controller.io]]`:
-  an output with `drives` writes `scale * value + offset` to a twin input at once (`aoAxis1` in mm
-  drives `L2` in m, as RobotStudio's expression blocks do); an input with `source` reads a twin output
+  an output with `drives` writes `scale * value + offset` to a twin input at once (`aoWidth` in mm
+  drives `width` in m, as RobotStudio's expression blocks do); an input with `source` reads a twin output
   live, `(twin value - offset) / scale`; the others live in the controller's memory. Motions drive
   the station's robot through the twin's motion API and are done when the robot is in position.
 - `ControllerDevice` is the twin's `Device`: it ticks the controller at the start of every simulation
@@ -102,7 +102,7 @@ class TwinHost:
             if isinstance(value, str):  # an enum output (GrippedPart): its index, 0 for none
                 value = self.twin.spec(sig.source).choices.index(value)
             return (float(value) - sig.offset) / sig.scale
-        if sig.drives:  # a wired output reads what it drives (aoAxis1 mirrors L2, whoever wrote L2 last)
+        if sig.drives:  # a wired output reads what it drives (aoWidth mirrors width, whoever wrote it last)
             value = self.twin.read(sig.drives)
             return (float(value) - sig.offset) / sig.scale
         return self.memory[name]

@@ -5,3 +5,6 @@
 Modbus/TCP front end; `twin.pacing` advances a cell in real time or in lockstep. The application that
 assembles them (the `twin` command, the cell) is `twin_app`, above this package.
 """
+from .moved import install as _install_moved
+
+_install_moved()  # old import paths of code that moved beside its station (twin.moved)

@@ -2,11 +2,11 @@
 
     from twin.faults import FaultInjector, PartMissing, FingerJammed, ReadingStuck
 
-    injector = FaultInjector.attach(twin, [PartMissing("ring", at=2.0),
-                                           FingerJammed("L2", position=0.300),       # m
-                                           ReadingStuck("L5.force", value=0.0, at=1.0)])
+    injector = FaultInjector.attach(twin, [PartMissing("part", at=2.0),
+                                           FingerJammed("axis1", position=0.300),    # m
+                                           ReadingStuck("axis2.force", value=0.0, at=1.0)])
     twin.step(500)
-    injector.log            # [(time, "PartMissing ring: started"), ...]
+    injector.log            # [(time, "PartMissing part: started"), ...]
 
 Every fault starts at `at` (s of simulated time, 0 = from the first step) and lasts `duration` s (None: to
 the end). The injector is a `Device` of the twin (the core steps it and knows nothing of faults), so the

@@ -3,11 +3,11 @@
     from twin.core import Twin
     from twin.recording import record, Recording
 
-    with Twin.from_station("stations/smart_gripper") as twin, record(twin, "run.parquet"):
-        twin.write("jaw_left", 0.011)
+    with Twin.from_station("stations/my_cell") as twin, record(twin, "run.parquet"):
+        twin.write("jaw", 0.011)
         twin.step(100)
     rec = Recording.open("run.parquet")     # or pandas.read_parquet / polars.read_parquet
-    rec.column("jaw_left.actual"), rec.time
+    rec.column("jaw.actual"), rec.time
 
 `twin serve STATION --record FILE` and `plc demo --record FILE` write the same file. One row per step,
 the first row the state before the first step (step 0), in the format described in docs/recording.md:

@@ -12,7 +12,7 @@ Then, once:
   - `hold` (default): an axis whose finger touches a part keeps its setpoint (the part stays squeezed and
     held); every other axis stops where it is (its setpoint becomes its actual position);
   - `stop`: every axis stops where it is (a squeezing grip relaxes to a touch);
-  - `open`: every axis goes to its open setpoint (`[watchdog] open = { L2 = 0.35 }`, else the station's
+  - `open`: every axis goes to its open setpoint (`[watchdog] open = { axis1 = 0.35 }`, else the station's
     `gripper.initial`, else it stops where it is).
 
 In lockstep, requests that only write or read `sim.advance` (a script driving simulated time and

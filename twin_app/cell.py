@@ -3,7 +3,7 @@
     from twin_app.cell import Cell
     from twin.modbus.front_end import ModbusFrontEnd
 
-    with Cell("stations/ring_rig_plc") as cell:          # twin + its RAPID controller as a Device
+    with Cell("stations/my_cell")    as cell:          # twin + its RAPID controller as a Device
         cell.add_front_end(ModbusFrontEnd(port=5020))     # Modbus/TCP; OPC UA and the view plug in alike
         asyncio.run(cell.serve(lockstep=True, stop=stop)) # one runner steps the cell; Ctrl-C or `stop` ends it
 

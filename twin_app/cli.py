@@ -3,7 +3,7 @@
     twin info STATION_OR_URDF [--json]
     twin serve STATION [Modbus flags: twin.modbus.cli] [--realtime | --lockstep] [--speed X]
     twin map STATION [--format json|csv|md]
-    twin demo [STATION] [--cycles N]
+    twin demo [STATION] [OPTIONS]  (a station's demo: its station.toml's [plugins] twin_demo)
     twin campaign ... (twin_app.campaign)
 
 `serve` assembles the cell (`twin_app.cell.Cell`) and plugs its front ends in (Modbus/TCP:
@@ -83,9 +83,9 @@ def cmd_info(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    from twin.demo import run_demo
+    from twin.plugins import run_station_demo
 
-    return run_demo(args.station, cycles=args.cycles)
+    return run_station_demo("twin_demo", args.demo_options, prog="twin demo", positional=True)
 
 
 def controller_log(event: dict) -> None:
@@ -225,10 +225,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("target", help="a gripper .urdf file, a station.toml or a station folder")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=cmd_info)
-    p = sub.add_parser("demo", help="run the headless demo of the ring rig (stations/ring_rig or a station like it) and print what happens")
-    p.add_argument("station", nargs="?", default=str(Path(__file__).resolve().parent.parent / "stations" / "ring_rig"))
-    p.add_argument("--cycles", type=int, default=1, help="how many full cycles to run")
-    p.set_defaults(func=cmd_demo)
+    p = sub.add_parser("demo", add_help=False, help="a station's demo through the simulation API, headless (its "
+                       "station.toml's [plugins] twin_demo; without STATION, the shipped one; `twin demo --help` lists "
+                       "its options)")
+    p.set_defaults(func=cmd_demo, takes_options=True)
     from .campaign.cli import add_command as add_campaign
 
     add_campaign(sub)
@@ -245,7 +245,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    from twin.plugins import parse_command_line
+
+    args = parse_command_line(build_parser(), argv)  # a station's demo keeps its own options
     try:
         return args.func(args)
     except TwinError as exc:

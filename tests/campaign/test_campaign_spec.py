@@ -13,7 +13,7 @@ HEAD = f"""
 [campaign]
 station = "{BENCH_STATION}"
 [driver]
-plc = "plc_client.ring_rig:sequence"
+plc = "stations.ring_rig_plc.plc_logic:sequence"
 [start]
 grip_request = true
 [run]
@@ -65,8 +65,8 @@ def test_mistakes_name_the_file_the_key_and_the_scenario(tmp_path, body, key, wo
 
 
 def test_a_driver_that_does_not_load_is_named(tmp_path):
-    path = write(tmp_path, "", head=HEAD.replace("plc_client.ring_rig:sequence", "plc_client.ring_rig:sequense"))
-    with pytest.raises(SpecError, match=r"driver.plc: 'plc_client.ring_rig:sequense': plc_client.ring_rig has no 'sequense'"):
+    path = write(tmp_path, "", head=HEAD.replace("stations.ring_rig_plc.plc_logic:sequence", "stations.ring_rig_plc.plc_logic:sequense"))
+    with pytest.raises(SpecError, match=r"driver.plc: 'stations.ring_rig_plc.plc_logic:sequense': stations.ring_rig_plc.plc_logic has no 'sequense'"):
         load_campaign(path)
 
 

@@ -13,7 +13,7 @@ SHIPPED = STATIONS / "ring_rig_plc" / "campaign.toml"
 
 def test_it_covers_offsets_sizes_a_missing_ring_a_jammed_finger_and_a_link_loss():
     c = load_campaign(SHIPPED)
-    assert c.driver.kind == "plc" and c.driver.ref == "plc_client.ring_rig:cell_sequence"
+    assert c.driver.kind == "plc" and c.driver.ref == "stations.ring_rig_plc.plc_logic:cell_sequence"
     params = [s.params for s in c.scenarios]
     assert any(p.get("ring.offset_x_mm") for p in params) and any(p.get("ring.offset_y_mm") for p in params)
     assert any("ring.outer_diameter_mm" in p for p in params)

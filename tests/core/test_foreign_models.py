@@ -190,9 +190,33 @@ def test_a_fixed_tip_named_as_finger_stands_for_its_finger(tmp_path):
 
 
 # -- twin demo ---------------------------------------------------------------------------------------------------
-def test_twin_demo_refuses_a_station_that_is_not_the_ring_rig_in_one_line():
-    out = subprocess.run([sys.executable, "-m", "twin", "demo", str(STATIONS / "four_finger")],
-                         capture_output=True, text=True, timeout=60)
+def twin_demo(*args):
+    return subprocess.run([sys.executable, "-m", "twin", "demo", *map(str, args)], capture_output=True, text=True,
+                          timeout=60)
+
+
+def test_twin_demo_refuses_a_station_without_a_demo_in_one_line_naming_those_with_one():
+    out = twin_demo(STATIONS / "four_finger")
+    assert out.returncode == 2, out.stderr
+    assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
+    assert "station 'four_finger' has no twin demo" in out.stderr and "[plugins] twin_demo" in out.stderr
+    assert "shipped stations with one: ring_rig" in out.stderr
+
+
+def test_the_ring_rig_demo_named_by_another_station_refuses_it_in_one_line(tmp_path):
+    toml = tmp_path / "station.toml"
+    text = (STATIONS / "four_finger" / "station.toml").read_text().replace('"gripper4.urdf"', f'"{STATIONS / "four_finger" / "gripper4.urdf"}"')
+    toml.write_text(text + '\n[plugins]\ntwin_demo = "stations.ring_rig.demo"\n')
+    out = twin_demo(tmp_path)
     assert out.returncode == 2, out.stderr
     assert out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
     assert "twin demo plays the ring rig" in out.stderr and "needs a robot; a target named ring" in out.stderr
+
+
+def test_a_station_plugin_that_cannot_be_loaded_is_named_by_its_key(tmp_path):
+    toml = tmp_path / "station.toml"
+    text = (STATIONS / "four_finger" / "station.toml").read_text().replace('"gripper4.urdf"', f'"{STATIONS / "four_finger" / "gripper4.urdf"}"')
+    toml.write_text(text + '\n[plugins]\ntwin_demo = "no_such_demo.py"\n')
+    out = twin_demo(tmp_path)
+    assert out.returncode == 2 and out.stderr.count("\n") == 1, out.stderr
+    assert f"{toml}: plugins.twin_demo: 'no_such_demo.py': no file" in out.stderr

@@ -4,7 +4,7 @@ import pytest
 from tests.conftest import STATIONS
 from twin.core import Twin
 from twin.core.errors import MotionError
-from twin.demo import FINGERS, Script
+from stations.ring_rig.demo import FINGERS, Script
 
 RIG = STATIONS / "ring_rig"
 

@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pytest
 
-from plc_client import ring_rig
+from stations.ring_rig_plc import plc_logic as ring_rig
 from plc_client.scan import ScanCycle, TwinIO
 from tests.conftest import STATIONS  # noqa: F401  (re-exported for the tests here)
 from twin.core import Twin

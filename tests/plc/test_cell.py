@@ -11,7 +11,7 @@ import sys
 
 import pytest
 
-from plc_client.cell_demo import CellDemo
+from stations.ring_rig_plc.demo import CellDemo
 from tests.conftest import ROOT
 from tests.view.demo_report import check_demo_report
 

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from plc_client.cell_demo import CellDemo, Summary, injected_fault_text
+from stations.ring_rig_plc.demo import CellDemo, Summary, injected_fault_text
 from plc_client.grip_sequence import Fault, Phase
 from tests.conftest import ROOT
 
@@ -26,7 +26,8 @@ def demo(*args, timeout=60):
      "plc: error: --remove-ring 3 is after the last cycle (--cycles 2): the ring would never be taken away"),
     (["--station", "/nonexistent"], "plc: error: /nonexistent: no such station file"),
     (["--station", "stations/smart_gripper"],
-     "plc: error: stations/smart_gripper: the demo needs a target 'ring' (its cell is stations/ring_rig_plc)"),
+     f"plc: error: {ROOT / 'stations' / 'smart_gripper' / 'station.toml'}: station 'smart_gripper' has no plc demo: "
+     "its station file names none under [plugins] plc_demo (shipped stations with one: ring_rig_plc)"),
 ])
 def test_bad_demo_arguments_are_one_line_and_exit_2(args, message):
     r = demo(*args)
@@ -43,7 +44,7 @@ def test_the_demo_help_says_what_the_exit_status_means():
 
 
 def test_importing_the_demo_does_not_import_the_pytest_plugin():
-    code = "import sys, plc_client.cell_demo, plc_client.cli; print('plc_client.testing' in sys.modules)"
+    code = "import sys, stations.ring_rig_plc.demo, plc_client.cli; print('plc_client.testing' in sys.modules)"
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert r.stdout.strip() == "False", r.stderr
 

@@ -37,7 +37,8 @@ def test_user_logic_on_the_scan_cycle_against_the_server(plc_server, twin_client
 
 @pytest.mark.parametrize("plc_station", [BENCH.with_name("ring_bench_empty")])  # the ring lies far away
 def test_the_documented_missed_grip_check(plc_server, twin_client):
-    from plc_client import Phase, ring_rig
+    from plc_client import Phase
+    from stations.ring_rig_plc import plc_logic as ring_rig
 
     seq = ring_rig.sequence()
     io = plc_server.io(twin_client, local=seq.handshake_signals())
@@ -50,8 +51,9 @@ def test_the_documented_missed_grip_check(plc_server, twin_client):
 
 @pytest.mark.parametrize("plc_station", [BENCH.parents[3] / "stations" / "ring_rig_plc"])
 def test_the_documented_full_cycle_check(plc_server, twin_client):
-    from plc_client import Combined, ring_rig
-    from plc_client.cell_demo import operator
+    from plc_client import Combined
+    from stations.ring_rig_plc import plc_logic as ring_rig
+    from stations.ring_rig_plc.demo import operator
 
     plc = ScanCycle(plc_server.io(twin_client), Combined(ring_rig.cell_sequence(), operator(cycles=1)))
     plc.run_until(lambda inputs, state: twin_client.get("goCyclesDone") == 1, timeout=60.0)
@@ -60,7 +62,8 @@ def test_the_documented_full_cycle_check(plc_server, twin_client):
 
 @pytest.mark.parametrize("plc_station", [BENCH])
 def test_a_part_taken_away_by_its_coil_makes_the_grip_miss(plc_server, twin_client):
-    from plc_client import Phase, ring_rig
+    from plc_client import Phase
+    from stations.ring_rig_plc import plc_logic as ring_rig
 
     seq = ring_rig.sequence()
     io = plc_server.io(twin_client, local=seq.handshake_signals())

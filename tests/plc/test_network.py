@@ -259,9 +259,9 @@ def test_plc_with_a_station_that_does_not_exist_is_one_line(tmp_path):
 
 # -- plc run -------------------------------------------------------------------------------------------------------
 def test_plc_run_of_a_logic_for_another_station_names_it_and_every_missing_signal(server):
-    r = plc(server, "run", "plc_client.ring_rig:cell_sequence", "--scans", "1")
+    r = plc(server, "run", "stations.ring_rig_plc.plc_logic:cell_sequence", "--scans", "1")
     assert r.returncode == 2 and len(r.stderr.splitlines()) == 1, r.stderr
-    assert r.stderr.startswith("plc: error: the logic plc_client.ring_rig:cell_sequence reads doGripRequest, "
+    assert r.stderr.startswith("plc: error: the logic stations.ring_rig_plc.plc_logic:cell_sequence reads doGripRequest, "
                                "doReleaseRequest, doGripInside, doPrepare, aoFingerReady and writes diGripOk, "
                                "diGripFault, diGripDone, which the register map (/tmp/twin-map-")
     assert r.stderr.rstrip().endswith("does not have (is it the logic for this station?)")

@@ -74,7 +74,7 @@ class Finger:
 
     @property
     def label(self) -> str:
-        """Its name, with the links fixed to it: `F1 (+F1_tip)`."""
+        """Its name, with the links fixed to it: `finger_a (+finger_a_tip)`."""
         return self.name + (f" (+{', '.join(self.links[1:])})" if len(self.links) > 1 else "")
 
 

@@ -155,6 +155,7 @@ class Station:
     controller: ControllerSpec | None
     watchdog: WatchdogSpec | None = None
     profile: dict | None = None  # the raw `[profile]` table: read and checked by twin.profiles, not the core
+    plugins: dict[str, str] = field(default_factory=dict)  # `[plugins]`: station code by reference (twin.plugins)
 
     @property
     def folder(self) -> Path:
@@ -451,11 +452,34 @@ def load_station(path: str | Path) -> Station:
                                 opened)
         wr.done()
     profile = top.get("profile", dict, None)  # a device profile's mapping (twin.profiles checks it)
+    plugins = _plugins(top)
     top.done()
     station = Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller,
-                      watchdog, profile)
+                      watchdog, profile, plugins)
     gripper_mechanism(station)  # the gripper's URDF and what the station says about it must agree
     return station
+
+
+PLUGIN_KEYS = ("twin_demo", "plc_demo", "plc_logic")  # what each one is: twin.plugins
+
+
+def _plugins(top: _Reader) -> dict[str, str]:
+    """`[plugins]`: references to the station's own code, checked for form only (loading is twin.plugins's)."""
+    pr = top.sub("plugins", required=False)
+    if pr is None:
+        return {}
+    plugins = {}
+    for key in PLUGIN_KEYS:
+        ref = pr.get(key, str, None, check=lambda v: None if v.strip() and " " not in v.strip() else
+                     'must be "package.module", "file.py", or either with ":name"')
+        if ref is not None:
+            plugins[key] = ref.strip()
+    moved = pr.get("moved", dict, {})  # old module name -> new one (twin.moved): kept for imports, not here
+    bad = [k for k, v in moved.items() if not isinstance(v, str)]
+    if bad:
+        raise pr.error(f"moved.{bad[0]}", "must be the module's new name (a string)")
+    pr.done()
+    return plugins
 
 
 def _check_robot_urdf(file: Path, robot: RobotSpec, given: bool) -> None:

@@ -7,7 +7,7 @@ starting anything.
 Layout, in the namespace `urn:gripper-twin:station:NAME` (NAME: the station's name):
 
     Objects/
-      Gripper/     Active, the joint setpoints (L2, ...), doGripped, GrippedPart, NAME.actual, .in_position, .moving
+      Gripper/     Active, the joint setpoints (one per input), doGripped, GrippedPart, NAME.actual, .in_position, .moving
       Fingers/     per finger NAME.contact, NAME.force
       Robot/       robot.busy, robot.j1 ..
       Targets/     per target NAME.present, NAME.x, NAME.y, NAME.z

@@ -9,13 +9,13 @@ jaw, the 3F's fingers A, B, C and its scissor). The station says what those mean
     mode_change_time = 1.0        # s a 3F grasping-mode change takes (gIMC 2 -> 3)
 
     [profile.jaw]                 # robotiq-2f: the one axis; robotiq-3f: [profile.A], .B, .C, .scissor
-    input = "jaw_left"            # the station input (joint setpoint) the axis drives
+    input = "jaw"                 # the station input (joint setpoint) the axis drives
     open = 0.025                  # the input's value at position 0 (SI: m or rad)
     closed = 0.0                  # ... at position 255
     speed = [0.0067, 0.05]        # m/s (rad/s) at speed 0 and 255 (default: the profile's ratio, the joint's limit)
     force = [0.43, 5.0]           # N (N*m) at force 0 and 255 (default: the profile's ratio, the joint's effort)
     current_full = 5.0            # the drive force that reads as current 255 (default: force's upper end)
-    finger = "jaw_left"           # the finger whose `NAME.status` (if the twin has it) gives object detection
+    finger = "jaw"                # the finger whose `NAME.status` (if the twin has it) gives object detection
 
 This module reads and checks the table; every mistake is a StationError naming the file and the key
 (`stations/x/station.toml: profile.A.input: ...`). It knows no protocol and no registers.

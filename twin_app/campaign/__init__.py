@@ -2,7 +2,7 @@
 faults and expectations, run scenario by scenario in lockstep on a local pool or a Dask cluster.
 
     from twin_app.campaign import load_campaign, run_campaign, LocalBackend
-    result = run_campaign(load_campaign("stations/ring_rig_plc/campaign.toml"), LocalBackend(2), "out/")
+    result = run_campaign(load_campaign("stations/my_cell/campaign.toml"), LocalBackend(2), "out/")
 
 See docs/campaigns.md; the command is `twin campaign SPEC.toml`.
 """

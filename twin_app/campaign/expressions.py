@@ -1,8 +1,8 @@
-"""Conditions in campaign files: small expressions such as `goCyclesDone >= 1 or doCycleFault` or
+"""Conditions in campaign files: small expressions such as `cycles_done >= 1 or cycle_fault` or
 `fault == 'ring_missing' and abs(ring.offset_x_mm) > 30`.
 
 They are parsed with Python's own parser and then checked: only names (dotted names such as
-`ring.offset_x_mm` or `L2.force` are one name), numbers, strings, true/false, comparisons, `and`/`or`/`not`,
+`ring.offset_x_mm` or `axis1.force` are one name), numbers, strings, true/false, comparisons, `and`/`or`/`not`,
 arithmetic and the functions `abs`, `min`, `max` and `round` are allowed, so a condition can read values but
 never run code.
 """

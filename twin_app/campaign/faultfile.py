@@ -4,7 +4,7 @@ faults of docs/campaigns.md in a served twin, so a commissioning check over Modb
 
     [faults.jam]
     kind = "finger_jammed"
-    input = "L2"
+    input = "axis1"
     position_mm = 326.0
     at = 0.5
 

@@ -1,7 +1,7 @@
 """Runs a campaign on a backend and writes its outputs; `--resume` picks up from the results file.
 
-    campaign = load_campaign("stations/ring_rig_plc/campaign.toml")
-    result = run_campaign(campaign, LocalBackend(workers=2), out_dir="campaign-results/ring_rig_plc")
+    campaign = load_campaign("stations/my_cell/campaign.toml")
+    result = run_campaign(campaign, LocalBackend(workers=2), out_dir="campaign-results/my_cell")
     result.counts        # {"pass": 9, "fail": 0, "error": 0}
 
 The results file (`results.jsonl`) gets one line per finished scenario as soon as it ends, so an

@@ -8,7 +8,7 @@ import dataclasses
 import math
 from typing import Any
 
-from .loading import load_object
+from twin.plugins import load_object
 from .spec import Campaign, Scenario
 from twin.core.device import ObservingDevice
 

@@ -213,7 +213,7 @@ def load_campaign(path: str | Path) -> Campaign:
     done_when = _expr(file, "run.done_when", run["done_when"]) if "done_when" in run else None
     stop = run.get("stop_when", {})
     if not isinstance(stop, dict):
-        raise SpecError(file, "run.stop_when", "must be a table of named conditions: { cycle_fault = \"doCycleFault\" }")
+        raise SpecError(file, "run.stop_when", "must be a table of named conditions: { cycle_fault = \"cycle_fault_bit\" }")
     stop_when = {k: _expr(file, f"run.stop_when.{k}", v) for k, v in stop.items()}
 
     faults = {}
@@ -315,7 +315,7 @@ def _driver(file, d: dict) -> Driver:
         raise SpecError(file, "driver.entry", f"must be a routine name, not {entry!r}")
     driver = Driver(kind, ref, entry, scan, file.parent.resolve())
     if kind != "rapid":
-        from .loading import LoadError, load_object
+        from twin.plugins import LoadError, load_object
 
         try:
             load_object(ref, driver.base)

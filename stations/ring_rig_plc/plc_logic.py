@@ -10,11 +10,12 @@ has missed the ring. A release opens at least back to where the next grip of the
 plays the robot; `cell_sequence()` speaks the robot program of `stations/ring_rig_plc` (doGripRequest,
 diGripDone, ...), with the prepare request that puts the fingers where the robot asks (aoFingerReady):
 
-    plc --port 5020 --station stations/ring_rig_plc run plc_client.ring_rig:cell_sequence
+    plc --port 5020 --station stations/ring_rig_plc run stations.ring_rig_plc.plc_logic:cell_sequence
+    plc --port 5020 --station stations/ring_rig_plc run          # the same: station.toml names it ([plugins])
 """
 from __future__ import annotations
 
-from .grip_sequence import GripSequence, Handshake
+from plc_client.grip_sequence import GripSequence, Handshake
 
 AXES = ("L2", "L3", "L4")
 FORCES = ("L2.force", "L3.force", "L5.force")

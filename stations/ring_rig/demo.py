@@ -1,4 +1,5 @@
-"""The headless demo of the ring rig through the simulation API: grip, lift and place the ring.
+"""The ring rig's demo through the simulation API (`twin demo`, named in station.toml's [plugins]): grip,
+lift and place the ring.
 
 It plays the thesis's sequence with Python in place of RAPID: approach, fingers to 330 mm, down,
 close 1 mm every 200 ms until `doGripped`, lift, carry to the other pallet, put down, open 1 mm every
@@ -11,8 +12,8 @@ import math
 import time
 from pathlib import Path
 
-from .core.errors import StationError
-from .core.station import Station, gripper_mechanism, load_station
+from twin.core.errors import StationError
+from twin.core.station import Station, gripper_mechanism, load_station
 
 FINGERS = ("L2", "L3", "L4")
 STEP_MM = 0.001  # the thesis's 1 mm per increment
@@ -104,7 +105,7 @@ def run_demo(station: str | Path, cycles: int = 1) -> int:
     wall0 = time.perf_counter()
     st = load_station(station)
     check_ring_rig(st)
-    from .core.twin import Twin  # after the check: importing pybullet prints a banner
+    from twin.core.twin import Twin  # after the check: importing pybullet prints a banner
 
     with Twin(st) as twin:
         s = Script(twin)
@@ -125,3 +126,13 @@ def run_demo(station: str | Path, cycles: int = 1) -> int:
               f"the ring ended {error * 1000:.1f} mm from its start "
               f"({end[0]:.4f}, {end[1]:.4f}, {end[2]:.4f})")
         return 0 if misses == 0 and error < 0.005 else 1
+
+
+def add_arguments(parser) -> None:
+    """`twin demo [STATION] [--cycles N]`: the options this demo adds to the command."""
+    parser.description = __doc__.split("\n\n")[0]
+    parser.add_argument("--cycles", type=int, default=1, help="how many full cycles to run")
+
+
+def main(args) -> int:
+    return run_demo(args.station, cycles=args.cycles)

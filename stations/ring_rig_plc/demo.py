@@ -1,4 +1,5 @@
 """The main job: the ring rig's full automatic cycle with its gripper PLC on the other side of the network.
+(This station's `plc demo`, named in its station.toml's [plugins]; `python3 tasks.py demo` runs it.)
 
     plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE] [--station DIR]
 
@@ -35,18 +36,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from . import ring_rig
-from .client import ClientIO
-from .errors import PlcClientError
-from .grip_sequence import INSIDE, Fault, Phase
-from .scan import Combined, ScanCycle, plc_logic
-
+from plc_client.client import ClientIO
+from plc_client.errors import PlcClientError
+from plc_client.grip_sequence import INSIDE, Fault, Phase
+from plc_client.scan import Combined, ScanCycle, plc_logic
 from twin.core.native_output import quiet_native_output
+
+from stations.ring_rig_plc import plc_logic as ring_rig
 
 # plc_client.testing (twin_server) is imported where the demo starts the server, not here: importing it
 # early keeps pytest from rewriting it when a test suite loads it as a plugin (PytestAssertRewriteWarning).
 
-DEFAULT_STATION = Path(__file__).resolve().parent.parent / "stations" / "ring_rig_plc"
+DEFAULT_STATION = Path(__file__).resolve().parent
 CYCLE_LIMIT_S = 120.0  # simulated seconds one cycle may take before the demo gives up
 RING_OK_MM = 5.0  # a cycle puts the ring back within this of where it started
 
@@ -146,7 +147,7 @@ class CellDemo:
             from twin.core.errors import TwinError
             from twin.core.station import load_station
 
-            from .testing import twin_server
+            from plc_client.testing import twin_server
             try:
                 station = load_station(self.station)
             except TwinError as exc:
@@ -328,7 +329,7 @@ def main(args) -> int:
     if args.remove_ring is not None and args.remove_ring > args.cycles:
         raise DemoError(f"--remove-ring {args.remove_ring} is after the last cycle (--cycles {args.cycles}): "
                         "the ring would never be taken away")
-    from .demo_report import recording_for, report
+    from plc_client.demo_report import recording_for, report
 
     lines: list[str] = []
     record = recording_for(args.record, args.report)
@@ -341,7 +342,8 @@ def main(args) -> int:
                     remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=record, out=out)
     summary = demo.run()
     if args.report is not None:
-        report(record, args.report, threshold=demo.grip.threshold, narration=lines)
+        report(record, args.report, threshold=demo.grip.threshold, narration=lines,
+               title="gripper-twin demo: the ring rig's automatic cycle")
     return summary.exit_status
 
 
@@ -353,15 +355,14 @@ EXIT_STATUS_HELP = """exit status:
   2  bad arguments, or a station the demo cannot run"""
 
 
-def add_command(sub) -> None:
+def add_arguments(p) -> None:
+    """The options of `plc demo` for this station (the command adds --station)."""
     import argparse
 
-    from .cli import positive_float, positive_int
+    from plc_client.cli import positive_float, positive_int
 
-    p = sub.add_parser("demo", help="the ring rig's full automatic cycle: twin server, RAPID robot, PLC over Modbus/TCP",
-                       description=__doc__.split("\n\n")[2], epilog=EXIT_STATUS_HELP,
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--station", metavar="DIR", default=str(DEFAULT_STATION), help="the cell (default stations/ring_rig_plc)")
+    p.description, p.epilog = __doc__.split("\n\n")[2], EXIT_STATUS_HELP
+    p.formatter_class = argparse.RawDescriptionHelpFormatter
     p.add_argument("--cycles", type=positive_int, metavar="N", default=1, help="full cycles to run (default 1)")
     p.add_argument("--realtime", action="store_true", help="run the twin against the wall clock (default: lockstep)")
     p.add_argument("--speed", type=positive_float, metavar="X", default=1.0, help="with --realtime: X times real time (default 1)")
@@ -376,13 +377,3 @@ def add_command(sub) -> None:
                      help="write the run's report there: index.html, the signal plot, the cell at each grip and release "
                           "(default demo-report)")
     rep.add_argument("--no-report", dest="report", action="store_const", const=None, help="no report")
-    p.set_defaults(func=main)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from .cli import Parser
-
-    parser = Parser(prog="cell_demo")
-    add_command(parser.add_subparsers(dest="command", required=True))
-    a = parser.parse_args(["demo", *sys.argv[1:]])
-    sys.exit(a.func(a))
