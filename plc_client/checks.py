@@ -5,8 +5,8 @@ an unknown name gets suggestions (`UnknownSignalError`), a value is checked agai
 for an entry without one against its type's (whole numbers for integer types of scale 1, finite float32),
 and an output of the twin is not writable. Nothing is clamped or rounded into range.
 
-    signal = lookup(rmap, "L2.actual")          # the entry, or UnknownSignalError ("did you mean ...?")
-    value = check_value(rmap, "L2", 320.0)      # 320.0, or a SignalValueError naming signal, value and range
+    signal = lookup(rmap, "axis1.actual")       # the entry, or UnknownSignalError ("did you mean ...?")
+    value = check_value(rmap, "axis1", 320.0)   # 320.0, or a SignalValueError naming signal, value and range
 """
 from __future__ import annotations
 
