@@ -1,4 +1,5 @@
-"""The OPC UA server's link to a running cell: the cell's exchange (`twin.exchange`), like every front end.
+"""The OPC UA server's link to a running cell: the cell's exchange (`twin.exchange`), like every front end,
+and its comm-loss watchdog (`twin.watchdog`), fed by every request of an OPC UA session.
 
 Writes go through `exchange.submit` (the same validation and queue as Modbus and the view: writes from all
 front ends apply in arrival order, at the next step, and show at once in Modbus's images too). After each
@@ -31,8 +32,9 @@ def status_of(exc: TwinError) -> str:
 
 
 class CellLink:
-    def __init__(self, exchange, runner=None):
-        self.exchange, self.runner = exchange, runner
+    def __init__(self, exchange, runner=None, watchdog=None):
+        """`watchdog`: the cell's comm-loss watchdog (`twin.watchdog`), fed by every request of a session."""
+        self.exchange, self.runner, self.watchdog = exchange, runner, watchdog
         self.twin = exchange.twin  # the station's name and step length
         self.server = None  # the OpcUaServer, once attached
         self._waiting: list[tuple[int, asyncio.Future]] = []
@@ -78,6 +80,15 @@ class CellLink:
                 fut.set_exception(AdvanceRefused("BadDeviceFailure", "the simulation faulted"))
 
     # -- the server's side ----------------------------------------------------------------------------
+    @property
+    def lockstep(self) -> bool:
+        return self.runner is not None and self.runner.mode == "lockstep"
+
+    def feed(self, source: str, clock_only: bool = False) -> None:
+        """A session's request came (see `twin.watchdog`): in lockstep, one that only drives simulated time
+        (`clock_only`) arms the watchdog without feeding it, as on Modbus."""
+        self.watchdog.feed(source, clock_only=self.lockstep and clock_only)
+
     def submit(self, changes: Sequence[tuple[Variable, object]]) -> str | None:
         try:
             self.exchange.submit([(var.name, value) for var, value in changes])

@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 from pathlib import Path
 
 from .security import POLICIES, Account, Security, SecurityError
@@ -93,7 +94,8 @@ async def start_opcua(link, *, host: str, port: int, security: Security):
 
     twin = link.twin
     space = build_address_space(link.signals(), twin.station.name)
-    server = OpcUaServer(space, step_s=twin.dt, submit=link.submit, advance=link.advance, security=security)
+    server = OpcUaServer(space, step_s=twin.dt, submit=link.submit, advance=link.advance, security=security,
+                         on_request=link.feed if link.watchdog is not None else None, clock_requests=link.lockstep)
     try:
         await server.start(host, port)
     except BaseException:
@@ -107,7 +109,8 @@ def options_from(args) -> dict | None:
     """`serve`'s keyword `opcua` from the parsed command line (None without --opcua)."""
     if getattr(args, "opcua", None) is None:
         return None
-    return {"host": args.opcua_host or args.host, "port": args.opcua, "security": security_from(args)}
+    return {"host": args.opcua_host or args.host, "port": args.opcua, "security": security_from(args),
+            "watchdog": getattr(args, "watchdog", None)}
 
 
 class OpcUaFrontEnd:
@@ -115,8 +118,11 @@ class OpcUaFrontEnd:
 
     name = "opcua"
 
-    def __init__(self, *, host: str = "127.0.0.1", port: int = DEFAULT_PORT, security: Security | None = None):
-        self.host, self.port, self.security = host, port, security or Security()
+    def __init__(self, *, host: str = "127.0.0.1", port: int = DEFAULT_PORT, security: Security | None = None,
+                 watchdog: float | None = None):
+        """`watchdog`: the comm-loss watchdog's seconds (`twin serve --watchdog S`; 0: off; None: the
+        station's), which every request of an OPC UA session feeds."""
+        self.host, self.port, self.security, self.watchdog = host, port, security or Security(), watchdog
         self.link = None
         self.server = None
 
@@ -132,7 +138,13 @@ class OpcUaFrontEnd:
 
         from .cell_link import CellLink
 
-        self.link = CellLink(cell.exchange, cell.runner)
+        watchdog = getattr(cell, "watchdog", None)
+        if watchdog is not None:
+            if self.watchdog is not None:
+                cell.set_watchdog_timeout(self.watchdog)
+            if hasattr(cell, "log"):
+                watchdog.log = lambda text: cell.log(text, logging.WARNING)
+        self.link = CellLink(cell.exchange, cell.runner, watchdog=watchdog)
         try:
             self.server = await start_opcua(self.link, host=self.host, port=self.port, security=self.security)
         except OSError as exc:
@@ -141,8 +153,9 @@ class OpcUaFrontEnd:
             raise TwinError(f"OPC UA security: {exc}") from None
         policies = ", ".join(self.security.policies_for(self.host))
         users = f", {len(self.security.accounts)} account(s), no anonymous" if self.security.accounts else ", anonymous"
+        fed = f", feeds the watchdog ({watchdog.timeout:g} s)" if watchdog is not None and watchdog.timeout else ""
         return [f"OPC UA: namespace {self.server.space.namespace_uri} (ns={self.server.ns}), {len(self.server.space)} "
-                f"variables, security {policies}{users}", f"OPC UA listening on {self.server.endpoint}"]
+                f"variables, security {policies}{users}{fed}", f"OPC UA listening on {self.server.endpoint}"]
 
     async def close(self) -> None:
         if self.link is not None:

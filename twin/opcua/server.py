@@ -31,10 +31,13 @@ from collections.abc import Awaitable, Callable, Mapping, Sequence
 from datetime import datetime, timezone
 
 from asyncua import Server, ua
+from asyncua.ua.ua_binary import nodeid_from_binary, struct_from_binary
 from asyncua.crypto.permission_rules import User, UserRole
 
 from .address_space import (ADVANCE_METHOD, BOOLEAN, DOUBLE, INT32, INT64, SIM_FOLDER, STRING, UINT32, AddressSpace,
                             Variable)
+from twin.core.signal_table import SIM_ADVANCE
+
 from .errors import AdvanceRefused
 from .security import Security
 
@@ -52,6 +55,7 @@ FASTEST_STEP_MS = 0.5  # wall time of a step at the fastest a cell runs (lockste
 
 Submit = Callable[[Sequence[tuple[Variable, object]]], str | None]  # -> None, or the name of a Bad status code
 Advance = Callable[[int], Awaitable[int]]  # lockstep: run n steps, return the step count when done
+OnRequest = Callable[[str, bool], None]  # (source, clock_only): a session's request came (the comm-loss watchdog)
 
 log = logging.getLogger("twin.opcua")
 
@@ -91,8 +95,13 @@ class OpcUaServer:
     """Serves an `AddressSpace`; the cell calls `publish` after each step (see the module docstring)."""
 
     def __init__(self, space: AddressSpace, *, step_s: float, submit: Submit, advance: Advance | None = None,
-                 security: Security | None = None, server_name: str | None = None):
+                 security: Security | None = None, server_name: str | None = None,
+                 on_request: OnRequest | None = None, clock_requests: bool = False):
+        """`on_request(source, clock_only)` is called for every request of an activated session (source:
+        "opcua HOST:PORT session N 'NAME'"); with `clock_requests` (lockstep), `clock_only` tells a request
+        that only drives or reads simulated time (Sim.Advance calls, reads and writes of `sim.advance`)."""
         self.space = space
+        self.on_request, self.clock_requests = on_request, clock_requests
         self.step_ms = step_s * 1000.0
         self._submit = submit
         self._advance = advance
@@ -127,6 +136,10 @@ class OpcUaServer:
         self.ns = await srv.register_namespace(self.space.namespace_uri)
         await self._build()
         self._hook_services()
+        if any(a.read_only for a in self.security.accounts):
+            from asyncua.common.callback import CallbackType
+
+            srv.subscribe_server_callback(CallbackType.PostRead, self._user_access_level)
         await srv.start()
         self._started = True
         self.host, self.port = host, port
@@ -266,7 +279,7 @@ class OpcUaServer:
             return await self._write(params, user, generic_write)
 
         attribute_service.write = write
-        _answer_calls_concurrently(iserver)
+        _hook_requests(iserver, self)
         subs = iserver.subscription_service
         create_subscription, create_items, modify_items = (subs.create_subscription, subs.create_monitored_items,
                                                            subs.modify_monitored_items)
@@ -370,6 +383,67 @@ class OpcUaServer:
             return "BadOutOfRange", None
         return _validate(var, value)
 
+    # -- sessions: the watchdog, and what a user may do ----------------------------------------------
+    def request_seen(self, processor, typeid: ua.NodeId, body) -> None:
+        """A request came on a connection (asyncua's UaProcessor): report it when it belongs to an activated
+        session. Never raises (a watchdog's trouble must not refuse a client's request)."""
+        if self.on_request is None:
+            return
+        try:
+            if typeid == _CREATE_SESSION:
+                processor.gripper_twin_session_name = _session_name(body)
+                return
+            session = processor.session
+            if session is None or not session.is_activated():
+                return
+            source = getattr(processor, "gripper_twin_source", None)
+            if source is None or getattr(processor, "gripper_twin_session", None) is not session:
+                source = self._source(processor, session)
+            clock_only = self.clock_requests and self._clock_only(typeid, body)
+            self.on_request(source, clock_only)
+        except Exception:  # noqa: BLE001
+            log.exception("OPC UA: the request hook failed")
+
+    @staticmethod
+    def _source(processor, session) -> str:
+        peer = processor.name
+        where = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) and len(peer) >= 2 else str(peer)
+        name = getattr(processor, "gripper_twin_session_name", "")
+        sid = session.session_id.Identifier
+        source = f"opcua {where} session {sid}" + (f" {name!r}" if name else "")
+        processor.gripper_twin_source, processor.gripper_twin_session = source, session
+        return source
+
+    def _clock_only(self, typeid: ua.NodeId, body) -> bool:
+        """The request only drives or reads simulated time: Sim.Advance calls, reads or writes of sim.advance
+        (a lockstep harness's clock, as `twin.modbus.pdu.PduHandler.clock_only`; see `twin.watchdog`)."""
+        if typeid not in (_CALL_REQUEST, _READ_REQUEST, _WRITE_REQUEST):
+            return False
+        b = _parameters(body)
+        if typeid == _CALL_REQUEST:
+            advance = self.node_id(ADVANCE_METHOD)
+            calls = struct_from_binary(ua.CallParameters, b).MethodsToCall or []
+            return bool(calls) and all(c.MethodId == advance for c in calls)
+        clock = self.node_id(SIM_ADVANCE)
+        if typeid == _READ_REQUEST:
+            items = struct_from_binary(ua.ReadParameters, b).NodesToRead or []
+        else:
+            items = struct_from_binary(ua.WriteParameters, b).NodesToWrite or []
+        return bool(items) and all(i.NodeId == clock for i in items)
+
+    def _user_access_level(self, event, _dispatcher) -> None:
+        """asyncua's PostRead callback: a read-only user's session reads the UserAccessLevel of an input as
+        CurrentRead only (the node's own attribute, the same for every session, says CurrentWrite)."""
+        if not self.security.read_only(event.user):
+            return
+        results = event.response_params
+        for i, rv in enumerate(event.request_params.NodesToRead or []):
+            if rv.AttributeId == ua.AttributeIds.UserAccessLevel and rv.NodeId in self._nodes:
+                dv = results[i]
+                if dv.Value is not None and dv.Value.Value is not None:
+                    level = int(dv.Value.Value) & ~ua.AccessLevel.CurrentWrite.mask
+                    results[i] = ua.DataValue(ua.Variant(level, ua.VariantType.Byte), StatusCode=dv.StatusCode)
+
     # -- Sim.Advance -----------------------------------------------------------------------------------
     async def _call_advance(self, parent: ua.NodeId, *args) -> ua.CallMethodResult | list[ua.Variant]:
         self.requests += 1
@@ -427,35 +501,58 @@ def _validate(var: Variable, value) -> tuple[str | None, object]:
 
 
 _CALL_REQUEST = ua.NodeId(ua.ObjectIds.CallRequest_Encoding_DefaultBinary)
+_READ_REQUEST = ua.NodeId(ua.ObjectIds.ReadRequest_Encoding_DefaultBinary)
+_WRITE_REQUEST = ua.NodeId(ua.ObjectIds.WriteRequest_Encoding_DefaultBinary)
+_CREATE_SESSION = ua.NodeId(ua.ObjectIds.CreateSessionRequest_Encoding_DefaultBinary)
 
 
-def _answer_calls_concurrently(iserver) -> None:
-    """asyncua internals: a connection's requests are processed one after another, so a Sim.Advance of a few
-    seconds would hold up that client's every other request (asyncua's client then drops the connection when
-    its watchdog read goes unanswered). Method calls to this server run as tasks of their own instead, and
-    are answered when done; the connection reads on. OPC UA matches responses by request handle."""
+def _hook_requests(iserver, server: "OpcUaServer") -> None:
+    """asyncua internals, at the door of every request of a connection (`UaProcessor.process_message`):
+
+    - every request of an activated session is reported to `server.request_seen` (the comm-loss watchdog);
+    - a connection's requests are processed one after another, so a Sim.Advance of a few seconds would hold
+      up that client's every other request (asyncua's client then drops the connection when its watchdog
+      read goes unanswered). Method calls to this server run as tasks of their own instead, and are answered
+      when done; the connection reads on. OPC UA matches responses by request handle.
+
+    The patch is on the class, but acts only for the servers that set `iserver.gripper_twin`."""
     from asyncua.server.uaprocessor import UaProcessor
-    from asyncua.ua.ua_binary import nodeid_from_binary
 
-    iserver.gripper_twin_concurrent_calls = True
+    iserver.gripper_twin = server
     if getattr(UaProcessor, "_gripper_twin_patched", False):
         return
     process_message = UaProcessor.process_message
 
-    async def concurrent_calls(self, seqhdr, body):
-        if getattr(self.iserver, "gripper_twin_concurrent_calls", False):
-            if nodeid_from_binary(body.copy()) == _CALL_REQUEST:
+    async def hooked(self, seqhdr, body):
+        server = getattr(self.iserver, "gripper_twin", None)
+        if server is not None:
+            typeid = nodeid_from_binary(body.copy())
+            server.request_seen(self, typeid, body)
+            if typeid == _CALL_REQUEST:
                 task = asyncio.ensure_future(process_message(self, seqhdr, body))
                 _CALLS.add(task)
                 task.add_done_callback(_CALLS.discard)
                 return True
         return await process_message(self, seqhdr, body)
 
-    UaProcessor.process_message = concurrent_calls
+    UaProcessor.process_message = hooked
     UaProcessor._gripper_twin_patched = True
 
 
 _CALLS: set = set()  # running method calls (a task needs a reference until it is done)
+
+
+def _parameters(body):
+    """A copy of a request's body, past its type id and request header: at its parameters."""
+    b = body.copy()
+    nodeid_from_binary(b)
+    struct_from_binary(ua.RequestHeader, b)
+    return b
+
+
+def _session_name(body) -> str:
+    """The SessionName a CreateSession request carries (the client's name for its session)."""
+    return struct_from_binary(ua.CreateSessionParameters, _parameters(body)).SessionName or ""
 
 
 _NO_DEADBAND = (None, ua.DeadbandType.None_)
