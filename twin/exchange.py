@@ -153,9 +153,10 @@ class Exchange:
         return self.twin.read(name)
 
     # -- the runner's side ----------------------------------------------------------------------------
-    def step(self, *, reraise: bool = False) -> bool:
+    def step(self, *, reraise: bool = False, publish: bool = True) -> bool:
         """Apply the queued writes, run one step, publish. False (and `fault`) if the twin failed; with
-        `reraise` (stepping in process), the error is raised instead."""
+        `reraise` (stepping in process), the error is raised instead. `publish=False` (a cell stepped in
+        process with nothing subscribed): no snapshot of this step; `publish()` takes one when wanted."""
         if self.fault:
             return False
         queue, self.pending = self.pending, []
@@ -172,6 +173,8 @@ class Exchange:
                      + traceback.format_exc().rstrip())
             self.publish()
             return False
+        if not publish:
+            return True
         self._in_step = True  # a lockstep runner counts this step as still to run until it returns
         try:
             self.publish()

@@ -39,8 +39,12 @@ The front-end contract (Modbus today; OPC UA and the web view plug in the same w
    done. Front ends use `cell.station` (names, units) and, for geometry only, `cell.twin` (never to
    step or write it).
 
-In process (tests, the in-process demo), a cell is also stepped directly: `cell.read`, `cell.write`
-(validated, next step), `cell.step(n)`, `cell.time`, as the twin's simulation API.
+In process (tests, the in-process demo, a campaign's scenario), a cell is also stepped directly:
+`cell.read`, `cell.write` (validated, next step), `cell.step(n)`, `cell.time`, as the twin's simulation
+API; more devices (fault injectors, recorders, monitors) go on `cell.twin.add_device` after the cell's
+own. `Cell(..., publish=False)`: a headless cell stepped in process (no front end, nothing subscribed)
+takes no snapshot per step, which costs a read of every signal; `cell.exchange.publish()` takes one on
+demand, and serving the cell publishes every step again.
 """
 from __future__ import annotations
 
@@ -89,13 +93,17 @@ class Cell:
     """A station's twin with its controller, the exchange its front ends use, and (while served) one runner."""
 
     def __init__(self, station: str | Path | Station, on_event: Callable[[dict], None] | None = None, *,
-                 entry: str | None = None, log: Callable[..., None] = _log, announce: Callable[[str], None] = _announce):
-        """Load a station; if it has a `[controller]`, its RAPID program runs as the robot controller.
+                 entry: str | None = None, log: Callable[..., None] = _log, announce: Callable[[str], None] = _announce,
+                 publish: bool = True):
+        """Load a station (a folder, a station.toml, or a `Station`, e.g. one with a campaign's parameters
+        applied); if it has a `[controller]`, its RAPID program runs as the robot controller.
 
         `on_event` receives the controller's events (TPWrite lines, output writes, motions, the end or a
         runtime error; see `rapid_like.controller`); `entry` overrides the station's entry routine.
         A program that does not parse or check raises a `rapid_like` error naming file:line:column.
+        `publish=False`: in-process steps take no snapshot (see the module docstring).
         """
+        self.publishing = publish
         self.station = station if isinstance(station, Station) else load_station(station)
         self.signals = station_signals(self.station)
         self.register_map: RegisterMap = build_register_map(self.signals, self.station.name)
@@ -153,9 +161,10 @@ class Cell:
             self.twin.write(name, value)
 
     def step(self, n: int = 1) -> None:
-        """Run n steps in process (queued front-end writes first), publishing each."""
+        """Run n steps in process (queued front-end writes first), publishing each (unless `publish=False`)."""
+        step, publish = self.exchange.step, self.publishing
         for _ in range(n):
-            self.exchange.step(reraise=True)
+            step(reraise=True, publish=publish)
 
     # -- served -----------------------------------------------------------------------------------------
     def add_front_end(self, front: FrontEnd) -> None:
@@ -163,6 +172,7 @@ class Cell:
 
     def pace(self, *, lockstep: bool = False, speed: float = 1.0):
         """Make the runner (it does not run yet): lockstep, or `speed` x real time."""
+        self.publishing = True  # front ends read every step's snapshot
         self.runner = LockstepRunner(self.exchange.step) if lockstep else RealtimeRunner(self.exchange.step, self.dt, speed)
         self.exchange.runner = self.runner
         self.exchange.publish()

@@ -1,6 +1,10 @@
 """One scenario, run in lockstep: the station with the scenario's parameters, its faults, its driver, and
 what was measured. `run_scenario(campaign, index)` returns a dict of plain values that depends only on the
 campaign file and the scenario (the same on every run, backend and machine): no wall time in it.
+
+The cell is assembled by `twin_app.cell.Cell` (the twin, the station's RAPID controller and the comm-loss
+watchdog as devices, as `twin serve` has them), in process and without front ends; the scenario adds its
+fault injector, monitor and recorder to the cell's twin, and steps the cell (the PLC through `TwinIO(cell)`).
 """
 from __future__ import annotations
 
@@ -283,7 +287,8 @@ def make_logic(campaign: Campaign, params: dict):
 class Context:
     """What a check function gets: the running twin and the scenario, and helpers that keep it in lockstep.
 
-    twin        the station's twin (with its RAPID controller, if the station has one) and the faults
+    cell        the running cell (twin_app.cell.Cell: read, write, step, time; in process, no front ends)
+    twin        the cell's twin (with its RAPID controller, if the station has one) and the faults
     params      the scenario's parameters (dict)
     scenario    the Scenario (name, index)
     io()        a lockstep PLC I/O to the twin (mm, N), through the scenario's link faults
@@ -291,9 +296,10 @@ class Context:
     measure(name, value)      add a value to the results table (and to expectations' `values`)
     """
 
-    def __init__(self, campaign: Campaign, scenario: Scenario, twin, link: dict, watchdog=None):
-        self.campaign, self.scenario, self.twin, self._link = campaign, scenario, twin, link
-        self.watchdog = watchdog  # the cell's comm-loss watchdog (twin_app.cell.add_watchdog)
+    def __init__(self, campaign: Campaign, scenario: Scenario, cell, link: dict):
+        self.campaign, self.scenario, self.cell, self._link = campaign, scenario, cell, link
+        self.twin = cell.twin
+        self.watchdog = cell.watchdog  # the cell's comm-loss watchdog
         self.params = dict(scenario.params)
         self.measured: dict = {}
         self.grip_watch: GripWatch | None = None
@@ -302,7 +308,7 @@ class Context:
         from plc_client.link import LinkFaults
         from plc_client.scan import TwinIO
 
-        io = TwinIO(self.twin, local=local)
+        io = TwinIO(self.cell, local=local)
         watchdog = self.watchdog
         feed = (lambda: watchdog.feed("plc")) if watchdog is not None and watchdog.timeout else None
         if self._link["lost"] or self._link["latency"] or self._link["jitter"] or feed:
@@ -337,10 +343,10 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
     import contextlib
     import time
 
-    from twin.core import Twin
     from twin.core.station import load_station
     from twin.faults import FaultInjector, FaultError
     from twin.core.native_output import quiet_native_output
+    from twin_app.cell import Cell
 
     params = scenario.params
     LAST_TIMING.clear()
@@ -355,20 +361,16 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
         program = (driver.base / driver.ref).resolve()
         station = dataclasses.replace(station, controller=dataclasses.replace(station.controller, program=program))
     with quiet_native_output():
-        twin = Twin(station)
+        # the cell as `twin serve` assembles it (watchdog, then the RAPID controller), headless and in process
+        cell = Cell(station, entry=driver.entry, publish=False)
+    twin = cell.twin
     stack = contextlib.ExitStack()
     try:
-        from twin_app.cell import add_watchdog
-
-        watchdog = add_watchdog(twin)  # the cell's comm-loss watchdog, as `twin serve` has it
+        watchdog = cell.watchdog
         if campaign.watchdog is not None:
-            watchdog.timeout = campaign.watchdog
+            cell.set_watchdog_timeout(campaign.watchdog)
         watchdog.log = lambda text: None
-        if station.controller is not None:
-            from rapid_like.station_host import attach_controller
-
-            attach_controller(twin, entry=driver.entry)
-        plant, link = build_faults(campaign, params, twin)
+        plant, link = build_faults(campaign, params, cell)
         if (link["lost"] or link["latency"] or link["jitter"]) and driver.kind == "rapid":
             raise ScenarioError("link faults act on a PLC's link: this campaign's driver is the RAPID program alone")
         try:
@@ -386,27 +388,27 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
         logic, local = None, {}
         if driver.kind == "plc":
             logic = make_logic(campaign, params)
-            have = {s.name for s in twin.signals}
+            have = {s.name for s in cell.signals}
             held = getattr(logic, "handshake_signals", None)
             local = {k: v for k, v in (held() if held else {}).items() if k not in have}
             missing = [n for n in (*logic.inputs, *getattr(logic, "outputs", ())) if n not in have and n not in local]
             if missing:
                 raise ScenarioError(f"driver.plc {driver.ref!r} uses {', '.join(missing)}, which station "
                                     f"{station.name!r} does not have")
-        signals = Signals(twin, local)
+        signals = Signals(cell, local)
         for key, value in {**campaign.start, **{k[6:]: v for k, v in params.items() if k.startswith("start.")}}.items():
             signals.check([key], f"start.{key}")
             signals.write(key, value)
         for t in station.targets:
             if params.get(f"{t.name}.present") is False:
-                twin.write(f"{t.name}.present", False)
+                cell.write(f"{t.name}.present", False)
         conditions = [(name, expr) for name, expr in campaign.stop_when.items()]
         cond_names = set().union(*(e.names for _, e in conditions), campaign.done_when.names if campaign.done_when else set())
         signals.check(cond_names, "run.stop_when / run.done_when")
         watch_signals = [s for s in (campaign.measure.get("grip"), campaign.measure.get("miss")) if s]
         signals.check(watch_signals, "measure")
         names = sorted(cond_names | set(watch_signals))
-        ctx = Context(campaign, scenario, twin, link, watchdog)
+        ctx = Context(campaign, scenario, cell, link)
         outcome = {"outcome": "", "fault": "none", "message": ""}
         t1 = time.perf_counter()
         LAST_TIMING["load"] = t1 - t0
@@ -422,7 +424,7 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
             if campaign.done_when is not None and campaign.done_when.evaluate(values):
                 outcome["outcome"] = "completed"
                 return True
-            if twin.time >= campaign.max_time - 1e-9:
+            if cell.time >= campaign.max_time - 1e-9:
                 if campaign.done_when is None:
                     outcome["outcome"] = "completed"
                 else:
@@ -447,7 +449,7 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
         elif driver.kind == "rapid":
             ctx.grip_watch = GripWatch(None, None, campaign.measure.get("grip") or "doGripped", campaign.measure.get("miss"))
             while True:
-                twin.step()
+                cell.step()
                 if verdict():
                     break
         else:
@@ -488,7 +490,7 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
         return result
     finally:
         stack.close()
-        twin.close()
+        cell.close()
 
 
 def _grip(grips: int, misses: int) -> str:
