@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import sys
 import time
 from dataclasses import dataclass, field
@@ -138,8 +139,9 @@ class CellDemo:
         self.grip = ring_rig.cell_sequence()  # the gripper PLC
         self.record = record  # twin serve --record FILE: every signal and body pose at every step
 
-    def say(self, who: str, text: str) -> None:
-        self.out(f"[t={self.now:8.3f} s] {who}: {text}")
+    def say(self, who: str, text: str, t: float | None = None) -> None:
+        """A narration line stamped with simulated time: `t` (the robot's own, from the server's log), else now."""
+        self.out(f"[t={self.now if t is None else t:8.3f} s] {who}: {text}")
 
     def run(self) -> Summary:
         """Run the cell; a `DemoError` (or another `PlcClientError`) when it cannot."""
@@ -187,8 +189,8 @@ class CellDemo:
         while True:
             image = plc.scan()
             self.now = image["sim.time_ms"] / 1000.0
-            for line in log.lines():
-                self.say("robot", line)
+            for t, line in log.lines():
+                self.say("robot", line, t)
             phase = grip_state.phase
             if phase != seen["phase"]:
                 self._narrate_grip(seen["phase"], grip_state, image, s)
@@ -219,8 +221,8 @@ class CellDemo:
             if self.now > limit:
                 self.say("demo", f"gave up: the cycles did not end within {limit:g} s of simulated time")
                 break
-        for line in log.lines():
-            self.say("robot", line)
+        for t, line in log.lines():
+            self.say("robot", line, t)
         self.scans, self.requests = plc.scans, client.requests
         self.cpu = (time.process_time() - cpu0[0], _process_cpu(server.process.pid) - cpu0[1])  # PLC, twin serve
         final = client.read("ring.present", "ring.x", "ring.y", "ring.z", "sim.time_ms")
@@ -308,7 +310,8 @@ class _LogTail:
     def __init__(self, path: Path):
         self.path, self.offset, self.rest = path, 0, ""
 
-    def lines(self) -> list[str]:
+    def lines(self) -> list[tuple[float | None, str]]:
+        """(simulated time the server stamped, text) of each new robot line."""
         with open(self.path, "r", encoding="utf-8", errors="replace") as f:
             f.seek(self.offset)
             text = f.read()
@@ -318,10 +321,11 @@ class _LogTail:
             text, _, self.rest = text.rpartition("\n")
         found = []
         for line in text.splitlines():
-            # "twin serve: [t=2.064 s] robot: Gripped ..." -> "Gripped ..."
+            # "twin serve: [t=2.064 s] robot: Gripped ..." -> (2.064, "Gripped ...")
             head, sep, tail = line.partition("] robot")
             if sep:
-                found.append(tail.lstrip(": ").strip())
+                stamp = re.search(r"\[t=\s*([0-9.]+) s$", head)
+                found.append((float(stamp.group(1)) if stamp else None, tail.lstrip(": ").strip()))
         return found
 
 

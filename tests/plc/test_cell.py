@@ -25,8 +25,11 @@ def run_cell(**kw):
 
 
 def narration(lines: list[str]) -> list[str]:
-    """The stamped lines, without what depends on the machine (wall time, port, pid)."""
-    return [re.sub(r"[\d.]+ s wall", "W s wall", line) for line in lines if line.startswith("[t=")]
+    """The stamped lines in simulated-time order, without what depends on the machine (wall time, port, pid).
+    (The robot's lines carry the time the server stamped; they reach the demo through the server's log,
+    written by a thread, so one may be printed a scan later than a PLC line of a later step.)"""
+    stamped = [re.sub(r"[\d.]+ s wall", "W s wall", line) for line in lines if line.startswith("[t=")]
+    return sorted(stamped, key=lambda line: (float(line[3:line.index(" s]")]), line))
 
 
 @pytest.fixture(scope="module")
