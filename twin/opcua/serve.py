@@ -13,12 +13,15 @@
 from __future__ import annotations
 
 import argparse
+import asyncio
 import logging
+import sys
 from pathlib import Path
 
 from .security import POLICIES, Account, Security, SecurityError
 
 DEFAULT_PORT = 4840
+SWITCH_INTERVAL = 0.0005  # s, see OpcUaFrontEnd.start
 
 
 def _port(text: str) -> int:
@@ -86,7 +89,8 @@ def check_arguments(args) -> str | None:
 
 
 async def start_opcua(link, *, host: str, port: int, security: Security):
-    """Build the station's address space and serve it on the cell behind `link` (a `CellLink` on its exchange).
+    """Build the station's address space and serve it on the cell behind `link` (a `CellLink` on its exchange);
+    run in the server's loop, then `link.attach(server)` in the cell's.
 
     Returns the started `OpcUaServer`; OSError when the port cannot be bound, SecurityError for bad options."""
     from .address_space import build_address_space
@@ -101,7 +105,6 @@ async def start_opcua(link, *, host: str, port: int, security: Security):
     except BaseException:
         await server.close()
         raise
-    link.attach(server)
     return server
 
 
@@ -125,6 +128,7 @@ class OpcUaFrontEnd:
         self.host, self.port, self.security, self.watchdog = host, port, security or Security(), watchdog
         self.link = None
         self.server = None
+        self.thread = None
 
     @classmethod
     def from_args(cls, args) -> "OpcUaFrontEnd | None":
@@ -136,7 +140,7 @@ class OpcUaFrontEnd:
         """Raises OSError when the port cannot be bound, TwinError for bad security options."""
         from twin.core.errors import TwinError
 
-        from .cell_link import CellLink
+        from .cell_link import CellLink, ServerThread
 
         watchdog = getattr(cell, "watchdog", None)
         if watchdog is not None:
@@ -144,13 +148,24 @@ class OpcUaFrontEnd:
                 cell.set_watchdog_timeout(self.watchdog)
             if hasattr(cell, "log"):
                 watchdog.log = lambda text: cell.log(text, logging.WARNING)
-        self.link = CellLink(cell.exchange, cell.runner, watchdog=watchdog)
+        # the asyncua server in a thread of its own: a request never waits behind a step, nor a step behind it
+        self.thread = ServerThread()
+        self.link = CellLink(cell.exchange, cell.runner, watchdog=watchdog, cell_loop=asyncio.get_running_loop(),
+                             server_loop=self.thread.loop)
+        # a thread waiting for the interpreter gets it after this long (default 5 ms): a request that comes
+        # while the simulation steps waits at most about this (pybullet's calls excepted)
+        sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL))
         try:
-            self.server = await start_opcua(self.link, host=self.host, port=self.port, security=self.security)
-        except OSError as exc:
-            raise OSError(f"OPC UA cannot listen on {self.host}:{self.port}: {exc.strerror or exc}") from None
-        except SecurityError as exc:
-            raise TwinError(f"OPC UA security: {exc}") from None
+            self.server = await self.thread.run(start_opcua(self.link, host=self.host, port=self.port,
+                                                            security=self.security))
+        except BaseException as exc:
+            self.thread.stop()
+            if isinstance(exc, OSError):
+                raise OSError(f"OPC UA cannot listen on {self.host}:{self.port}: {exc.strerror or exc}") from None
+            if isinstance(exc, SecurityError):
+                raise TwinError(f"OPC UA security: {exc}") from None
+            raise
+        self.link.attach(self.server)
         policies = ", ".join(self.security.policies_for(self.host))
         users = f", {len(self.security.accounts)} account(s), no anonymous" if self.security.accounts else ", anonymous"
         fed = f", feeds the watchdog ({watchdog.timeout:g} s)" if watchdog is not None and watchdog.timeout else ""
@@ -160,5 +175,9 @@ class OpcUaFrontEnd:
     async def close(self) -> None:
         if self.link is not None:
             self.link.detach()
-        if self.server is not None:
-            await self.server.close()
+        if self.thread is not None:
+            try:
+                if self.server is not None:
+                    await asyncio.wait_for(self.thread.run(self.server.close()), 10)
+            finally:
+                self.thread.stop()
