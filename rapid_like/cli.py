@@ -39,7 +39,7 @@ from . import nodes as n
 from .controller import DEFAULT_LOOP_BUDGET, read_source, task_files
 from .errors import RapidError
 from .host import SIGNAL_KINDS, SignalInfo
-from .offline import DEFAULT_TIME_LIMIT, SignalChange, run_offline
+from .offline import DEFAULT_STEP, DEFAULT_TIME_LIMIT, SignalChange, run_offline
 from .parser import parse
 
 EX_OK, EX_USAGE, EX_DATAERR, EX_NOINPUT, EX_SOFTWARE = 0, 2, 65, 66, 70
@@ -119,9 +119,10 @@ def build_parser() -> argparse.ArgumentParser:
                      help="end the run at simulated time T, reason time_limit (without it: a program "
                           f"still running at {DEFAULT_TIME_LIMIT:g} s ends there, and one that waits for "
                           "a signal nothing changes is an error)")
-    run.add_argument("--step", type=float, default=0.012, metavar="S",
+    run.add_argument("--step", type=float, default=DEFAULT_STEP, metavar="S",
                      help="the controller's tick: a loop that used up its loop budget goes on S seconds "
-                          "later, or earlier at a --set change or a pulse edge (default 0.012)")
+                          f"later, or earlier at a --set change or a pulse edge (default {DEFAULT_STEP:g}, as a "
+                          "station's step)")
     run.add_argument("--loop-budget", type=int, default=DEFAULT_LOOP_BUDGET, metavar="N",
                      help="loop iterations that consume no time run per tick before the loop waits for "
                           f"the next tick (default {DEFAULT_LOOP_BUDGET})")

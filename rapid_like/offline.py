@@ -31,6 +31,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
+from twin.core.defaults import DEFAULT_STEP
+
 from . import nodes as n
 from .controller import DEFAULT_LOOP_BUDGET, ERROR, WAITING, Controller
 from .errors import ExecError
@@ -61,7 +63,7 @@ DEFAULT_TIME_LIMIT = 3600.0
 
 
 def run_offline(module: n.Module | n.Task, signals: list[SignalInfo], changes: list[SignalChange] = (),
-                entry: str = "main", max_time: float | None = None, step: float = 0.012,
+                entry: str = "main", max_time: float | None = None, step: float = DEFAULT_STEP,
                 on_event: Callable[[dict], None] | None = None,
                 default_limit: float = DEFAULT_TIME_LIMIT, loop_budget: int = DEFAULT_LOOP_BUDGET,
                 answers: list[str] | None = None, cycles: int = 1, infer_signals: bool = False) -> Outcome:

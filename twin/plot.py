@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from .core.errors import TwinError
+from .core.signals import ENGINEERING_UNITS as ENGINEERING
 from .recording import Recording
 
-ENGINEERING = {"m": ("mm", 1000.0), "rad": ("deg", 180.0 / np.pi)}
 FORMATS = (".png", ".svg")
 
 

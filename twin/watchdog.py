@@ -34,8 +34,8 @@ import math
 from collections.abc import Callable, Mapping
 
 from twin.core.signal_table import COMM_LOST, watchdog_signals
+from twin.core.defaults import SAFE_STATES
 
-SAFE_STATES = ("hold", "open", "stop")
 
 
 class Watchdog:

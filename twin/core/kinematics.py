@@ -25,8 +25,7 @@ from pybullet_utils.bullet_client import BulletClient
 from .errors import MotionError
 from .geometry import Pose, quat_conj, quat_mul
 from .native_output import quiet_native_output
-
-ARM_JOINTS = ("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6")
+from .defaults import ARM_JOINTS
 
 #: IK converges when the TCP is this close (m, rad) ...
 IK_TOL_POS = 1e-4

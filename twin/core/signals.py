@@ -21,6 +21,15 @@ FLOAT = "float"  # a physical quantity in `unit`
 INT = "int"      # a count (steps, ...)
 ENUM = "enum"    # one of `choices`; read as the choice's text, index 0 means "none"
 
+#: The units a PLC, the register map, a plot and the live page show instead of an SI unit: SI unit ->
+#: (engineering unit, factor), SI value * factor = the value shown. Other units are shown as they are.
+ENGINEERING_UNITS = {"m": ("mm", 1000.0), "rad": ("deg", 180.0 / math.pi)}
+
+
+def engineering_unit(unit: str) -> tuple[str, float]:
+    """(the unit shown, factor from SI) for a signal's SI unit: mm for m, deg for rad, else the unit itself."""
+    return ENGINEERING_UNITS.get(unit, (unit, 1.0))
+
 
 @dataclass(frozen=True)
 class SignalSpec:

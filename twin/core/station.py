@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .defaults import ARM_JOINTS, DEFAULT_STEP, SAFE_STATES
 from .errors import MechanismError, StationError
 from .mechanism import MOVABLE, FingerNameError, Mechanism, load_mechanism, read_links_and_joints
 
@@ -102,7 +103,7 @@ class RobotSpec:
     base: Placement
     home_deg: tuple[float, ...]
     flange_link: str = "flange"
-    joints: tuple[str, ...] = ("joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6")
+    joints: tuple[str, ...] = ARM_JOINTS
 
 
 @dataclass(frozen=True)
@@ -137,7 +138,6 @@ class WatchdogSpec:
     open: dict[str, float] = field(default_factory=dict)  # open setpoints by input name (default: gripper.initial)
 
 
-SAFE_STATES = ("hold", "open", "stop")
 
 
 @dataclass(frozen=True)
@@ -328,7 +328,7 @@ def load_station(path: str | Path) -> Station:
 
     st = top.sub("station")
     name = st.get("name", str, file.parent.name)
-    step = st.number("step", 0.012, positive=True)
+    step = st.number("step", DEFAULT_STEP, positive=True)
     substeps = st.get("substeps", int, 4, check=lambda v: None if 1 <= v <= 100 else "must be between 1 and 100")
     gravity = st.vector("gravity", 3, (0.0, 0.0, -9.81))
     st.done()

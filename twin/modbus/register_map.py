@@ -60,7 +60,7 @@ from twin.core.signal_table import (SIM_ADVANCE as ADVANCE, SIM_DT_US as DT_US, 
                                     SIM_MAP_CRC as MAP_CRC, SIM_MODE as MODE, SIM_SIGNALS, SIM_SPEED_PCT as SPEED_PCT,
                                     SIM_STEP as STEP, SIM_TIME_MS as TIME_MS, WATCHDOG_MS, station_signals)
 from twin.core.errors import TwinError
-from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
+from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec, engineering_unit
 from twin.core.station import load_station
 
 COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER = "coil", "discrete_input", "holding_register", "input_register"
@@ -77,13 +77,9 @@ TYPE_LIMITS = {"uint16": (0, 0xFFFF), "int16": (-0x8000, 0x7FFF), "uint32": (0, 
            "int32": (-0x80000000, 0x7FFFFFFF), "bool": (0, 1)}
 _STRUCT = {"uint16": ">H", "int16": ">h", "uint32": ">I", "int32": ">i", "float32": ">f"}
 
-# SI unit -> (map unit, factor from SI to the map unit, scale in map units per count)
-UNITS = {
-    "m": ("mm", 1000.0, 0.01),
-    "rad": ("deg", 180.0 / math.pi, 0.01),
-    "N": ("N", 1.0, 0.01),
-    "N*m": ("N*m", 1.0, 0.01),
-}
+# SI unit -> (map unit, factor from SI to the map unit, scale in map units per count): the engineering units
+# of `twin.core.signals.ENGINEERING_UNITS` (mm, deg; forces as they are), in counts of 0.01
+UNITS = {si: (*engineering_unit(si), 0.01) for si in ("m", "rad", "N", "N*m")}
 
 
 

@@ -75,6 +75,8 @@ import time
 from collections import deque
 from collections.abc import Callable, Iterable
 
+from twin.core.defaults import DEFAULT_STEP
+
 from .log import log as _log
 from .pdu import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
                   SERVER_DEVICE_FAILURE, Backend, Deferred, DeviceIdentity, Images, PduHandler)
@@ -123,7 +125,7 @@ class ModbusServer:
     """Serve `rmap` from `backend` over Modbus/TCP (see the module docstring)."""
 
     def __init__(self, rmap: RegisterMap, backend: Backend, *, unit_id: int = 1, frame_timeout: float = 1.0,
-                 requests_per_step: int = REQUESTS_PER_STEP, step_period: float = 0.012,
+                 requests_per_step: int = REQUESTS_PER_STEP, step_period: float = DEFAULT_STEP,
                  serve_share: float = SERVE_SHARE, max_connections: int = MAX_CONNECTIONS,
                  idle_timeout: float | None = None, allow: Iterable | None = None, read_only: bool = False,
                  gaps_zero: bool = False, identity: DeviceIdentity | None = None,

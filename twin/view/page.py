@@ -23,9 +23,9 @@ from typing import Protocol
 
 import numpy as np
 
+from twin.core.signals import ENGINEERING_UNITS as ENGINEERING  # as the Modbus map and the PLC see them
 from twin.observe import Frame, Scene, matrix_to_quat, pose_matrix, setpoint_motion
 
-ENGINEERING = {"m": ("mm", 1000.0), "rad": ("deg", 180.0 / math.pi)}  # as the Modbus map and the PLC see them
 HIGHLIGHT = (40, 220, 90)  # the gripped part
 CONTACT, NO_CONTACT = (230, 30, 30), (120, 120, 120)
 FORCE_COLOUR = (250, 200, 0)
