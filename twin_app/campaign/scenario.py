@@ -15,8 +15,9 @@ from typing import Any
 from twin.plugins import load_object
 from .spec import Campaign, Scenario
 from twin.core.device import ObservingDevice
+from twin.core.signals import ENGINEERING_UNITS
 
-UNIT_TO_MAP = {"m": 1000.0, "rad": 180.0 / math.pi}  # SI -> the map's units (mm, deg), as a PLC sees them
+UNIT_TO_MAP = {si: factor for si, (_, factor) in ENGINEERING_UNITS.items()}  # SI -> the map's units (mm, deg)
 # wall seconds of the last scenario run in this process: loading the station, running the driver (for the
 # benchmark; never part of the results, which must not depend on the wall clock)
 LAST_TIMING: dict[str, float] = {}
