@@ -182,7 +182,7 @@ def tls_from_args(args):
 
 
 def device_identity(station, rmap):
-    """What function 43/14 answers: vendor, product code, version, the station's name."""
+    """What function 43/14 answers: vendor and product code (DeviceIdentity's), version, the station's name."""
     from importlib import metadata
 
     from .pdu import MAP_CRC_OBJECT, STATION_NAME_OBJECT, DeviceIdentity
@@ -192,8 +192,7 @@ def device_identity(station, rmap):
     except metadata.PackageNotFoundError:
         version = "0.1.0"
     name = station.name
-    return DeviceIdentity(vendor="gripper-twin", product_code="GT-TWIN-SERVE", revision=version,
-                          product_name="gripper-twin Modbus/TCP server", model_name="twin serve",
+    return DeviceIdentity(revision=version, product_name="gripper-twin Modbus/TCP server", model_name="twin serve",
                           user_application_name=name,
                           extended={STATION_NAME_OBJECT: name, MAP_CRC_OBJECT: f"{rmap.crc:08x}"})
 

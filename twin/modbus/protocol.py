@@ -12,6 +12,8 @@ MAX_READ_BITS, MAX_READ_REGISTERS = 2000, 125  # functions 1, 2 / 3, 4
 MAX_WRITE_BITS, MAX_WRITE_REGISTERS = 1968, 123  # functions 15 / 16
 MAX_RW_READ, MAX_RW_WRITE = 125, 121  # function 23: its read part, its write part
 
+ADDRESSES = 0x10000  # addresses per table (16-bit, 0..65535)
+
 # -- exception codes ----------------------------------------------------------------------------------------
 ILLEGAL_FUNCTION, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, SERVER_DEVICE_FAILURE = 0x01, 0x02, 0x03, 0x04
 GATEWAY_TARGET_FAILED = 0x0B

@@ -63,6 +63,8 @@ from twin.core.errors import TwinError
 from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec, engineering_unit
 from twin.core.station import load_station
 
+from .protocol import ADDRESSES
+
 COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER = "coil", "discrete_input", "holding_register", "input_register"
 TABLES = (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)
 BIT_TABLES = (COIL, DISCRETE_INPUT)
@@ -251,6 +253,7 @@ class RegisterMap:
     by_name: Mapping[str, Entry] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
+        object.__setattr__(self, "entries", tuple(self.entries))
         object.__setattr__(self, "by_name", {e.name: e for e in self.entries})
         object.__setattr__(self, "meta", MappingProxyType(dict(self.meta)))
 
@@ -421,8 +424,8 @@ def _entry_from_dict(e: Any, where: str, i: int) -> Entry:
     if entry.count != WIDTH[type_]:
         raise bad(f"a {type_} takes {WIDTH[type_]} {'bit' if bit else 'register'}{'s' if WIDTH[type_] > 1 else ''}, "
                   f"not count {entry.count}")
-    if not (0 <= entry.address and entry.end <= 0x10000):
-        raise bad(f"address {entry.address} is outside 0..65535")
+    if not (0 <= entry.address and entry.end <= ADDRESSES):
+        raise bad(f"address {entry.address} is outside 0..{ADDRESSES - 1}")
     if entry.access not in ("r", "rw") or (entry.access == "rw" and table not in (COIL, HOLDING_REGISTER)):
         raise bad(f"access {entry.access!r}: 'r', or 'rw' in the coils and holding registers")
     if not entry.scale > 0:
@@ -522,8 +525,8 @@ def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> Regi
             continue
         e = _signal_entry(s, table, nxt[table])
         nxt[table] = e.end
-        if e.end > 0x10000:
-            raise MapError(f"signal {s.name!r}: the {table} table is full (65536 addresses)")
+        if e.end > ADDRESSES:
+            raise MapError(f"signal {s.name!r}: the {table} table is full ({ADDRESSES} addresses)")
         entries.append(e)
     order = {t: i for i, t in enumerate(TABLES)}
     entries.sort(key=lambda e: (order[e.table], e.address))
