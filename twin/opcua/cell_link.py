@@ -188,6 +188,8 @@ class CellLink:
             values, applied = queue.popleft()
             if server is not None:
                 server.publish(values, applied)
+        if server is not None:
+            server.send_due()
 
     def feed(self, source: str, clock_only: bool = False) -> None:
         """A session's request came (see `twin.watchdog`): in lockstep, one that only drives simulated time
