@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import gc
 import logging
 import sys
 from pathlib import Path
@@ -166,6 +167,10 @@ class OpcUaFrontEnd:
                 raise TwinError(f"OPC UA security: {exc}") from None
             raise
         self.link.attach(self.server)
+        # the address space (tens of thousands of asyncua objects) lives as long as the server: keep it out of
+        # the collector's full passes, which would otherwise stop the simulation for milliseconds at a time
+        gc.collect()
+        gc.freeze()
         policies = ", ".join(self.security.policies_for(self.host))
         users = f", {len(self.security.accounts)} account(s), no anonymous" if self.security.accounts else ", anonymous"
         fed = f", feeds the watchdog ({watchdog.timeout:g} s)" if watchdog is not None and watchdog.timeout else ""
