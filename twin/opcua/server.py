@@ -41,6 +41,7 @@ from twin.core.signal_table import SIM_ADVANCE
 
 from .errors import AdvanceRefused
 from .security import Security
+from .serve import DEFAULT_PORT  # 4840, IANA's opcua-tcp (defined with the --opcua option; a light module)
 
 VARIANT = {BOOLEAN: ua.VariantType.Boolean, DOUBLE: ua.VariantType.Double, INT32: ua.VariantType.Int32,
            UINT32: ua.VariantType.UInt32, INT64: ua.VariantType.Int64, STRING: ua.VariantType.String}
@@ -122,7 +123,7 @@ class OpcUaServer:
         self._started = False
 
     # -- start and stop ---------------------------------------------------------------------------------
-    async def start(self, host: str = "127.0.0.1", port: int = 4840) -> tuple[str, int]:
+    async def start(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> tuple[str, int]:
         """Build the address space and listen. Port 0: any free port. Returns the bound host and port."""
         srv = self.server
         await srv.init()
