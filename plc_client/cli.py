@@ -26,6 +26,7 @@ import argparse
 import logging
 import sys
 
+from twin.cli_args import positive_float, positive_int
 from twin.core.errors import TwinError
 from twin.modbus.protocol import DEFAULT_PORT, TLS_PORT
 
@@ -42,26 +43,6 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str):
         self.exit(EXIT_USER, f"{self.prog}: error: {message} (`{self.prog} --help` tells more)\n")
-
-
-def positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a number, not {text!r}") from None
-    if not (v > 0 and v != float("inf")):
-        raise argparse.ArgumentTypeError(f"must be greater than 0, not {text}")
-    return v
-
-
-def positive_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a whole number, not {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, not {text}")
-    return v
 
 
 def _globals(parser: argparse.ArgumentParser, suppress: bool) -> None:

@@ -20,42 +20,16 @@ import logging
 import sys
 from pathlib import Path
 
+from twin.cli_args import nonnegative_float, positive_float, positive_int, tcp_port
+
 from .log import LEVELS, log as _log
 from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT
-
-
-def _positive(text: str) -> float:
-    v = float(text)
-    if not v > 0:
-        raise argparse.ArgumentTypeError(f"must be positive, not {text}")
-    return v
-
-
-def _port(text: str) -> int:
-    v = int(text)
-    if not 0 <= v <= 0xFFFF:
-        raise argparse.ArgumentTypeError(f"a TCP port is 0..65535, not {text}")
-    return v
 
 
 def _unit(text: str) -> int:
     v = int(text)
     if not 0 <= v <= 255:
         raise argparse.ArgumentTypeError(f"a unit id is 0..255, not {text}")
-    return v
-
-
-def _nonnegative(text: str) -> float:
-    v = float(text)
-    if not v >= 0 or v == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be 0 or more seconds, not {text}")
-    return v
-
-
-def _count(text: str) -> int:
-    v = int(text)
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, not {text}")
     return v
 
 
@@ -90,7 +64,7 @@ def add_commands(subparsers, cmd_serve):
 def add_serve_arguments(p) -> None:
     """The Modbus front end's flags of `twin serve` (and the runner's: --realtime/--lockstep, --speed)."""
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback only)")
-    p.add_argument("--port", type=_port, default=DEFAULT_PORT, help=f"TCP port (default {DEFAULT_PORT}; 0 = any free port, printed)")
+    p.add_argument("--port", type=tcp_port, default=DEFAULT_PORT, help=f"TCP port (default {DEFAULT_PORT}; 0 = any free port, printed)")
     p.add_argument("--unit-id", type=_unit, default=None,
                    help="Modbus unit id answered (default 1; 0 and 255 too); with --profile: the profile's unit id "
                         "(default: every unit id but --map-unit-id)")
@@ -99,19 +73,19 @@ def add_serve_arguments(p) -> None:
                       help="step paced to the wall clock at the station's step (the default)")
     mode.add_argument("--lockstep", action="store_true",
                       help="step only when a client writes N to the holding register sim.advance")
-    p.add_argument("--speed", type=_positive, default=1.0, help="real time: X times real time (default 1)")
-    p.add_argument("--frame-timeout", type=_positive, default=1.0,
+    p.add_argument("--speed", type=positive_float, default=1.0, help="real time: X times real time (default 1)")
+    p.add_argument("--frame-timeout", type=positive_float, default=1.0,
                    help="s a client may take to complete a frame it started (default 1)")
     p.add_argument("--log-level", choices=LEVELS, default="info",
                    help="debug, info (connections: the default), warning (watchdog, refusals of note), error")
     g = p.add_argument_group("running next to a real network (see the Modbus README)")
-    g.add_argument("--max-connections", type=_count, default=MAX_CONNECTIONS,
+    g.add_argument("--max-connections", type=positive_int, default=MAX_CONNECTIONS,
                    help=f"connections served at once; one more is refused and logged (default {MAX_CONNECTIONS})")
-    g.add_argument("--idle-timeout", type=_nonnegative, default=0.0,
+    g.add_argument("--idle-timeout", type=nonnegative_float, default=0.0,
                    help="close a connection with no request for S seconds (default 0: never)")
-    g.add_argument("--requests-per-step", type=_count, default=REQUESTS_PER_STEP,
+    g.add_argument("--requests-per-step", type=positive_int, default=REQUESTS_PER_STEP,
                    help=f"requests answered per step period over all connections, shared fairly (default {REQUESTS_PER_STEP})")
-    g.add_argument("--watchdog", type=_nonnegative, default=None, metavar="S",
+    g.add_argument("--watchdog", type=nonnegative_float, default=None, metavar="S",
                    help="comm-loss watchdog: no request for S s puts the gripper in the station's safe state and "
                         "raises comm.lost (default: the station's [watchdog] timeout, else off; 0: off)")
     g.add_argument("--read-only", action="store_true",
@@ -123,7 +97,7 @@ def add_serve_arguments(p) -> None:
     g.add_argument("--tls-cert", metavar="PEM", help="Modbus/TCP Security: the server's certificate")
     g.add_argument("--tls-key", metavar="PEM", help="the server certificate's private key")
     g.add_argument("--tls-ca", metavar="PEM", help="CA certificate(s) client certificates must chain to (required)")
-    g.add_argument("--tls-port", type=_port, default=TLS_PORT, help=f"the TLS port (default {TLS_PORT}; 0 = any free)")
+    g.add_argument("--tls-port", type=tcp_port, default=TLS_PORT, help=f"the TLS port (default {TLS_PORT}; 0 = any free)")
     g.add_argument("--tls-only", action="store_true", help="with TLS: do not listen on plain Modbus/TCP (--port)")
     _add_profile_arguments(p)
 

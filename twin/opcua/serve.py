@@ -19,17 +19,12 @@ import logging
 import sys
 from pathlib import Path
 
+from twin.cli_args import tcp_port
+
 from .security import POLICIES, Account, Security, SecurityError
 
 DEFAULT_PORT = 4840
 SWITCH_INTERVAL = 0.0005  # s, see OpcUaFrontEnd.start
-
-
-def _port(text: str) -> int:
-    v = int(text)
-    if not 0 <= v <= 0xFFFF:
-        raise argparse.ArgumentTypeError(f"a TCP port is 0..65535, not {text}")
-    return v
 
 
 def _policies(text: str) -> tuple[str, ...]:
@@ -50,7 +45,7 @@ def _account(text: str) -> str:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     g = parser.add_argument_group("OPC UA", "serve the same cell on OPC UA (asyncua; see docs/opcua.md)")
-    g.add_argument("--opcua", nargs="?", type=_port, const=DEFAULT_PORT, default=None, metavar="PORT",
+    g.add_argument("--opcua", nargs="?", type=tcp_port, const=DEFAULT_PORT, default=None, metavar="PORT",
                    help=f"serve OPC UA too, on PORT (default {DEFAULT_PORT}; 0 = any free port, printed)")
     g.add_argument("--no-modbus", action="store_true", help="serve OPC UA only (needs --opcua)")
     g.add_argument("--opcua-host", default=None, help="address OPC UA binds (default: that of --host)")

@@ -11,25 +11,7 @@ from __future__ import annotations
 
 import argparse
 
-
-def _positive(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"needs a number, not {text!r}") from None
-    if not v > 0 or v == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be positive, not {text}")
-    return v
-
-
-def _port(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"a TCP port is a whole number, not {text!r}") from None
-    if not 0 <= v <= 0xFFFF:
-        raise argparse.ArgumentTypeError(f"a TCP port is 0..65535, not {text}")
-    return v
+from twin.cli_args import positive_float, tcp_port
 
 
 def _pixels(text: str) -> int:
@@ -48,11 +30,11 @@ def add_commands(sub, open_cell) -> None:
                        description="Run a station and serve a live 3D page of it (or replay a recording).")
     p.add_argument("station", nargs="?", help="a station folder or station.toml (or --replay FILE)")
     p.add_argument("--host", default="127.0.0.1", help="address the page binds (default loopback only)")
-    p.add_argument("--port", type=_port, default=8080, help="HTTP port (default 8080; the next free one if taken; 0 = any)")
+    p.add_argument("--port", type=tcp_port, default=8080, help="HTTP port (default 8080; the next free one if taken; 0 = any)")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--realtime", dest="lockstep", action="store_false", help="run against the wall clock (default)")
     mode.add_argument("--lockstep", action="store_true", help="step only from the page's Step / Advance buttons")
-    p.add_argument("--speed", type=_positive, default=1.0, help="real time: X times real time (default 1)")
+    p.add_argument("--speed", type=positive_float, default=1.0, help="real time: X times real time (default 1)")
     p.add_argument("--paused", action="store_true", help="real time: start paused (Run on the page starts it)")
     p.add_argument("--record", metavar="FILE", default=None, help="also record every step into FILE (.parquet or .csv)")
     p.add_argument("--replay", metavar="FILE", default=None, help="play a recording back, with a timeline")

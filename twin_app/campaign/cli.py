@@ -8,6 +8,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+
+from twin.cli_args import positive_float
 from pathlib import Path
 
 
@@ -19,16 +21,6 @@ def _workers(text: str) -> int:
     if n < 1:
         raise argparse.ArgumentTypeError("at least 1 worker")
     return n
-
-
-def _seconds(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
-    if not v > 0:
-        raise argparse.ArgumentTypeError("must be greater than 0")
-    return v
 
 
 def _indices(text: str) -> list[int]:
@@ -53,7 +45,7 @@ def add_command(subparsers) -> None:
                    "(e.g. tcp://10.0.0.5:8786; needs pip install 'gripper-twin[cluster]')")
     p.add_argument("--out", "-o", help="the output folder (default: campaign-results/SPEC_NAME)")
     p.add_argument("--resume", action="store_true", help="skip the scenarios already in the output folder's results file")
-    p.add_argument("--timeout", type=_seconds, help="wall seconds one scenario may take (default: run.timeout of the file)")
+    p.add_argument("--timeout", type=positive_float, help="wall seconds one scenario may take (default: run.timeout of the file)")
     p.add_argument("--only", type=_indices, metavar="N,M-K", help="run only these scenarios (by number)")
     p.add_argument("--recordings", type=int, default=10, metavar="N",
                    help="record and plot at most N failing scenarios (re-run, in failures/; default 10, 0: none)")
