@@ -91,6 +91,8 @@ ENTRY = {"name": "L2", "table": "holding_register", "address": 16, "type": "uint
     ({"table": "input_register", "access": "rw"}, r"entry 1 \('L2'\): access 'rw'"),
     ({"min": 500}, r"entry 1 \('L2'\): min 500 is above max 441"),
     ({"name": "sim.step"}, r"entry 1 \('sim.step'\): the name appears twice \(entry 0 too\)"),
+    ({"table": "input_register", "access": "r", "address": 1},  # sim.step is a uint32 at 0..1
+     r"entry 1 \('L2'\) at input_register 1 overlaps entry 0 \('sim.step', addresses 0..1\)"),
 ])
 def test_a_bad_entry_in_a_map_file_names_the_file_and_the_entry(tmp_path, change, message):
     path = tmp_path / "ring.json"

@@ -306,6 +306,7 @@ class RegisterMap:
                 raise MapError(f"{label}: entry {i} ({e.name!r}): the name appears twice (entry {seen[e.name]} too)")
             seen[e.name] = i
             entries.append(e)
+        _check_no_overlap(entries, label)
         station = meta.get("station")
         return cls(tuple(entries), station if isinstance(station, str) else "", source=where, meta=meta)
 
@@ -433,6 +434,17 @@ def _entry_from_dict(e: Any, where: str, i: int) -> Entry:
     if entry.min is not None and entry.max is not None and entry.min > entry.max:
         raise bad(f"min {entry.min:g} is above max {entry.max:g}")
     return entry
+
+
+def _check_no_overlap(entries: list[Entry], label: str) -> None:
+    """Two entries of one table may not share an address: a client would decode one from the other's words."""
+    index = {id(e): i for i, e in enumerate(entries)}
+    for table in TABLES:
+        held = sorted((e for e in entries if e.table == table), key=lambda e: e.address)
+        for a, b in zip(held, held[1:]):
+            if b.address < a.address + a.count:
+                raise MapError(f"{label}: entry {index[id(b)]} ({b.name!r}) at {table} {b.address} overlaps entry "
+                               f"{index[id(a)]} ({a.name!r}, addresses {a.address}..{a.address + a.count - 1})")
 
 
 def _num(v):
