@@ -125,6 +125,8 @@ class OpcUaFrontEnd:
         self.link = None
         self.server = None
         self.thread = None
+        self._switch_interval = sys.getswitchinterval()
+        self._frozen = False
 
     @classmethod
     def from_args(cls, args) -> "OpcUaFrontEnd | None":
@@ -150,12 +152,14 @@ class OpcUaFrontEnd:
                              server_loop=self.thread.loop)
         # a thread waiting for the interpreter gets it after this long (default 5 ms): a request that comes
         # while the simulation steps waits at most about this (pybullet's calls excepted)
-        sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL))
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
         try:
             self.server = await self.thread.run(start_opcua(self.link, host=self.host, port=self.port,
                                                             security=self.security))
         except BaseException as exc:
             self.thread.stop()
+            sys.setswitchinterval(self._switch_interval)
             if isinstance(exc, OSError):
                 raise OSError(f"OPC UA cannot listen on {self.host}:{self.port}: {exc.strerror or exc}") from None
             if isinstance(exc, SecurityError):
@@ -166,6 +170,7 @@ class OpcUaFrontEnd:
         # the collector's full passes, which would otherwise stop the simulation for milliseconds at a time
         gc.collect()
         gc.freeze()
+        self._frozen = True
         policies = ", ".join(self.security.policies_for(self.host))
         users = f", {len(self.security.accounts)} account(s), no anonymous" if self.security.accounts else ", anonymous"
         fed = f", feeds the watchdog ({watchdog.timeout:g} s)" if watchdog is not None and watchdog.timeout else ""
@@ -181,3 +186,7 @@ class OpcUaFrontEnd:
                     await asyncio.wait_for(self.thread.run(self.server.close()), 10)
             finally:
                 self.thread.stop()
+                sys.setswitchinterval(self._switch_interval)
+                if self._frozen:  # in process (a test, an application): back to the collector as before
+                    gc.unfreeze()
+                    self._frozen = False
