@@ -166,6 +166,13 @@ class Gripper:
         self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
         self._contact_points = client.getContactPoints
         self._quiet = False
+        # the joints' states as last read (after the last physics substep: what the next drive starts from), and
+        # the drive command last sent (pybullet keeps it: an identical one is not sent again)
+        self._states = None
+        self._sent: tuple | None = None
+        self._per_input = [(name, self.unit[name], MOVING_SPEED[self.unit[name]]) for name in self.names]
+        self._joint_axis = {f: client.getJointInfo(body, j)[13] for f, j in self.finger_joint.items()}
+        self._joint_frames: dict[str, tuple] = {}  # revolute fingers' joint frames, this substep
         self.state = GripState()
         self._reset_sums()
         self.sense()
@@ -281,7 +288,8 @@ class Gripper:
     def drive(self, substep: int = 0) -> None:
         """Before a physics substep: move each command on along its ramp and set each drive's velocity and force.
         Drives that all stand still at their goal, pressing on nothing, keep the first substep's settings for the
-        rest of the step: nothing changes there but cost."""
+        rest of the step: nothing changes there but cost. The joints' states are those `measure` read after the
+        substep before (nothing moves the joints in between)."""
         if substep and self._quiet:
             return
         if not self.active and self._hold is None:
@@ -290,30 +298,38 @@ class Gripper:
             self._hold = None
         goal = self._hold if self._hold is not None else self.setpoint
         h = self.h
-        states = self._joint_states(self.body, self._joint_ids)
+        states = self._states
+        if states is None:
+            states = self._states = self._joint_states(self.body, self._joint_ids)
         velocities, forces = [], []
         quiet = True
-        for name, (actual, joint_speed, _, _) in zip(self.names, states):
-            d = self.drives[name]
-            before = self.command_position[name]
+        drives, command = self.drives, self.command_position
+        for (name, _, moving), (actual, joint_speed, _, _) in zip(self._per_input, states):
+            d = drives[name]
+            before = command[name]
             target = _towards(before, goal[name], d.velocity * h)
             # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
-            full = d.full_error
+            full = d.effort / d.stiffness
             target = min(max(target, actual - full), actual + full)
-            self.command_position[name] = target
+            command[name] = target
             error = target - actual
             limit = SPEED_MARGIN * d.velocity
             speed = min(max((target - before) / h + POSITION_GAIN * error / h, -limit), limit)
-            if abs(error) > max(BLOCKED_SHARE * full, 2 * d.velocity * h) and abs(joint_speed) < MOVING_SPEED[self.unit[name]]:
+            standing = abs(joint_speed) < moving
+            if standing and abs(error) > max(BLOCKED_SHARE * full, 2 * d.velocity * h):
                 # held back by a part: pybullet's solver builds a motor's force only as fast as the velocity it asks
                 # for, so a held-back drive asks for far more; its force limit is then what it presses with
                 speed = BLOCKED_SPEEDUP * d.velocity * (1.0 if error > 0 else -1.0)
             velocities.append(speed)
             forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
-            quiet = (quiet and before == goal[name] and abs(joint_speed) < MOVING_SPEED[self.unit[name]]
+            quiet = (quiet and before == goal[name] and standing
                      and abs(error) < BLOCKED_SHARE * full)  # a drive pressing on a part is followed every substep
         self._quiet = quiet
-        self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities, forces=forces)
+        sent = (velocities, forces)
+        if sent != self._sent:  # pybullet keeps a motor's command: the same one needs no call
+            self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
+                         forces=forces)
+            self._sent = sent
 
     def measure(self, last: bool = True) -> None:
         """After a physics substep: add up the drives' applied forces and the fingers' contact forces. While every
@@ -321,9 +337,12 @@ class Gripper:
         if self._quiet and not last:
             return
         self._n += 1
-        for i, s in enumerate(self._joint_states(self.body, self._joint_ids)):
-            self._effort_sum[i] += s[3]
+        states = self._states = self._joint_states(self.body, self._joint_ids)
+        efforts = self._effort_sum
+        for i, s in enumerate(states):
+            efforts[i] += s[3]
         sums, finger_of, contact_points = self._force_sum, self._finger_of_link, self._contact_points
+        self._joint_frames.clear()
         for uid in self.targets.values():
             for pt in contact_points(self.body, uid):
                 finger = finger_of.get(pt[3])
@@ -338,12 +357,12 @@ class Gripper:
 
     def _torque(self, finger: str, pt) -> float:
         """The torque about a revolute finger's joint axis of one contact's normal force on the part."""
-        c = self.client
-        joint = self.finger_joint[finger]
-        info = c.getJointInfo(self.body, joint)
-        link = c.getLinkState(self.body, joint)
-        origin, orn = link[4], link[5]  # the child link's URDF frame: the joint's frame
-        axis = _rotate(orn, info[13])
+        frame = self._joint_frames.get(finger)
+        if frame is None:  # the joint's frame and axis in the world, read once per substep
+            link = self.client.getLinkState(self.body, self.finger_joint[finger])
+            origin = link[4]  # the child link's URDF frame: the joint's frame
+            frame = self._joint_frames[finger] = (origin, _rotate(link[5], self._joint_axis[finger]))
+        origin, axis = frame
         r = [pt[5][i] - origin[i] for i in range(3)]
         f = [-pt[7][i] * pt[9] for i in range(3)]  # the normal on B points at A (the finger): the force on B is -n
         tau = (r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0])
@@ -352,18 +371,21 @@ class Gripper:
     # -- after each step --------------------------------------------------------------------------------------
     def sense(self) -> None:
         """Read joints, efforts and contacts after physics; decide grip, attachment, slip and status."""
-        c, n = self.client, max(1, self._n)
+        n = max(1, self._n)
+        if not self._n:  # no substep measured since the last sense (a new gripper): read the joints now
+            self._states = self._joint_states(self.body, self._joint_ids)
         axes = {}
-        for i, (name, s) in enumerate(zip(self.names, c.getJointStates(self.body, self._joint_ids))):
+        for i, (name, s) in enumerate(zip(self.names, self._states)):
             axes[name] = AxisState(s[0], s[1], self._effort_sum[i] / n if self._n else 0.0)
         self.state.axes = axes
-        pressing: dict[str, dict[str, float]] = {f: {} for f in self.finger_links}
+        pressing: dict[str, dict[str, float]] = {}
         for (finger, uid), total in self._force_sum.items():
-            pressing[finger][self._target_by_id[uid]] = total / n
+            pressing.setdefault(finger, {})[self._target_by_id[uid]] = total / n
         friction = self.spec.grip == "friction"
         fingers = {}
         for finger in self.finger_links:
-            on = {t: pressing[finger].get(t, 0.0) for t in self.targets if pressing[finger].get(t, 0.0) > 0.0}
+            pressed = pressing.get(finger)
+            on = {t: pressed[t] for t in self.targets if pressed.get(t, 0.0) > 0.0} if pressed else {}
             # friction mode: no contact without a normal force, so a finger pressing on nothing needs no query
             touching = self._touching(finger, CONTACT_SLACK) if on else () if friction else self._touching(finger)
             contacts = tuple(t for t in touching if not friction or t in on)
@@ -395,7 +417,7 @@ class Gripper:
     def _pressed_by_all(self, threshold: dict[str, float], only: str | None = None) -> list[str]:
         """The targets (station order) every finger presses on with at least its threshold force."""
         fingers = self.state.fingers
-        if not fingers:
+        if not fingers or not all(f.contacts for f in fingers.values()):
             return []
         names = [only] if only else list(self.targets)
         return [t for t in names if all(t in f.contacts and f.pressing.get(t, 0.0) >= threshold[name]

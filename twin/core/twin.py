@@ -91,6 +91,7 @@ class Twin:
         self._placed = dict(self._present)  # as applied to the world
         self._target_of = {f"{t.name}.present": t for t in st.targets}
         self._outputs: dict[str, object] = {}
+        self._index_outputs()
         self._publish()
 
     def close(self) -> None:
@@ -190,28 +191,43 @@ class Twin:
         self._outputs = {**self._outputs, **values}
 
     def _publish(self) -> None:
-        g, out = self.gripper.state, {}
+        g, setpoint, out = self.gripper.state, self.gripper.setpoint, {}
         out["doGripped"] = bool(g.gripped)
         out["GrippedPart"] = g.gripped
         out["slip"] = g.slip
-        for inp in self.mechanism.inputs:
-            axis = g.axes[inp.name]
-            out[f"{inp.name}.actual"] = axis.actual
-            out[f"{inp.name}.in_position"] = abs(axis.actual - self.gripper.setpoint[inp.name]) <= IN_POSITION_TOLERANCE[inp.unit]
-            out[f"{inp.name}.moving"] = abs(axis.velocity) > MOVING_SPEED[inp.unit]
-            out[f"{inp.name}.effort"] = axis.effort
-        for name, finger in g.fingers.items():
-            out[f"{name}.contact"] = bool(finger.contacts)
-            out[f"{name}.force"] = finger.force
-            out[f"{name}.status"] = finger.status
+        axes = g.axes
+        for name, actual_key, in_position_key, moving_key, effort_key, tolerance, moving in self._axis_keys:
+            axis = axes[name]
+            out[actual_key] = axis.actual
+            out[in_position_key] = abs(axis.actual - setpoint[name]) <= tolerance
+            out[moving_key] = abs(axis.velocity) > moving
+            out[effort_key] = axis.effort
+        fingers = g.fingers
+        for name, contact_key, force_key, status_key in self._finger_keys:
+            finger = fingers[name]
+            out[contact_key] = bool(finger.contacts)
+            out[force_key] = finger.force
+            out[status_key] = finger.status
         if self.robot is not None:
             out["robot.busy"] = self.robot.busy(self.time)
-            for i, q in enumerate(self.robot.q, start=1):
-                out[f"robot.j{i}"] = float(q)
-        for t in self.station.targets:
-            (x, y, z), _ = self.world.pose(t.name)
-            out[f"{t.name}.x"], out[f"{t.name}.y"], out[f"{t.name}.z"] = x, y, z
+            for key, q in zip(self._robot_keys, self.robot.q):
+                out[key] = float(q)
+        pose = self.world.client.getBasePositionAndOrientation
+        for uid, x_key, y_key, z_key in self._target_keys:
+            out[x_key], out[y_key], out[z_key] = pose(uid)[0]
         self._outputs = out
+
+    def _index_outputs(self) -> None:
+        """The output names published at every step, spelled out once (not formatted anew at every step)."""
+        self._axis_keys = [(i.name, f"{i.name}.actual", f"{i.name}.in_position", f"{i.name}.moving",
+                            f"{i.name}.effort", IN_POSITION_TOLERANCE[i.unit], MOVING_SPEED[i.unit])
+                           for i in self.mechanism.inputs]
+        self._finger_keys = [(name, f"{name}.contact", f"{name}.force", f"{name}.status")
+                             for name in self.gripper.state.fingers]
+        self._robot_keys = ([f"robot.j{i}" for i in range(1, len(self.robot.joints) + 1)]
+                            if self.robot is not None else [])
+        self._target_keys = [(self.world.body_ids[t.name], f"{t.name}.x", f"{t.name}.y", f"{t.name}.z")
+                             for t in self.station.targets]
 
     # -- robot motion -----------------------------------------------------------------------------
     def target(self, name: str):
