@@ -331,6 +331,11 @@ class Gripper:
                          forces=forces)
             self._sent = sent
 
+    @property
+    def quiet(self) -> bool:
+        """Every drive stood at its goal, pressing on nothing, at the last step's first substep."""
+        return self._quiet
+
     def measure(self, last: bool = True) -> None:
         """After a physics substep: add up the drives' applied forces and the fingers' contact forces. While every
         drive stands quiet, the step's last substep alone is read (nothing moves in between)."""

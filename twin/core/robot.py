@@ -131,6 +131,11 @@ class Robot:
         self._paused = self.q if paused else None
 
     @property
+    def moving(self) -> bool:
+        """A motion runs or has not yet settled, and the arm is not paused (unlike `busy`, no side effects)."""
+        return self._traj is not None and not self._settled and self._paused is None
+
+    @property
     def paused(self) -> bool:
         return self._paused is not None
 

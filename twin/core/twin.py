@@ -127,13 +127,22 @@ class Twin:
                 gripper.drive(k)
                 if robot is not None:
                     robot.update(t + k * h)
+                if k == 0:  # a cell at rest has its loose bodies frozen: thawed before anything may move them
+                    world.stasis.before_physics(self._machine_still())
                 world.substep_physics()
                 gripper.measure(k == world.substeps - 1)
             self.step_count += 1
             self.gripper.sense()
             self._publish()
+            world.stasis.after_step(self._machine_still())
             for device in self.devices:
                 device.after_step(self)
+
+    def _machine_still(self) -> bool:
+        """The arm idle and every gripper drive standing at its goal, holding nothing (stasis.py)."""
+        g = self.gripper
+        return (g.quiet and not g.state.gripped and not g.state.attached
+                and (self.robot is None or not self.robot.moving))
 
     # -- signals ------------------------------------------------------------------------------------
     def spec(self, name: str) -> SignalSpec:
@@ -336,6 +345,7 @@ class Twin:
                 continue
             body = self._target_of[key]
             uid, c = self.world.body_ids[body.name], self.world.client
+            self.world.stasis.thaw()  # (its mass is changed here)
             if not want:
                 self.gripper.forget(body.name)
                 c.resetBasePositionAndOrientation(uid, [0, 0, -100], [0, 0, 0, 1])

@@ -204,6 +204,10 @@ class World:
             self._build(station, gripper_root)
         bind_calls(self.client)
         self._step_simulation = self.client.stepSimulation
+        from .stasis import Stasis
+
+        loose = [self.body_ids[b.name] for b in (*station.fixtures, *station.targets) if b.dynamic]
+        self.stasis = Stasis(self.client, self.machine, loose)  # loose bodies frozen while the cell rests
 
     def _build(self, station: Station, gripper_root: str) -> None:
         self.body_ids: dict[str, int] = {}
