@@ -1,7 +1,7 @@
 """The main job: the ring rig's full automatic cycle with its gripper PLC on the other side of the network.
 (This station's `plc demo`, named in its station.toml's [plugins]; `python3 tasks.py demo` runs it.)
 
-    plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE] [--station DIR]
+    plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE] [--faults FILE] [--station DIR]
 
 It starts `twin serve` for `stations/ring_rig_plc` as a subprocess (the twin and its RAPID robot
 controller), connects a scan-cycle PLC to it over Modbus/TCP, and runs as the cell's operator: it sets
@@ -17,9 +17,12 @@ PLC's view, both stamped with simulated time, then a summary: cycles, grips, mis
 simulated and in wall seconds, and how far the ring ends from where it started. `--remove-ring K`
 takes the ring out of the cell (coil `ring.present`) when cycle K starts: the miss is detected and
 reported, never hidden: the summary says whether the injected miss was detected and the robot stopped.
+`--faults FILE` gives the served twin plant faults (`twin serve --faults`: `[faults.NAME]` tables as in a
+campaign, e.g. a finger jammed or its drive lost): the summary says which faults the PLC reported.
 
 Exit status: 0 when every cycle was done and the ring is back within 5 mm of where it started; with
---remove-ring, 0 when the injected miss was detected and the robot stopped the cycle; 1 otherwise;
+--remove-ring, 0 when the injected miss was detected and the robot stopped the cycle; with --faults, 0
+when the cycles were done as without it, or the PLC reported a fault and the robot stopped the cycle; 1 otherwise;
 2 for bad arguments or a station the demo cannot run.
 
 Lockstep (the default): the PLC advances the twin one scan at a time, so the run is repeatable to the
@@ -92,6 +95,8 @@ class Summary:
     remove_ring_at: int | None = None  # --remove-ring: the cycle at whose start the ring is taken away
     ring_removed: bool = False  # ... and it was (cycle `remove_ring_at` started)
     misses_after_removal: int = 0  # misses the PLC detected once the ring was gone
+    faults: str | None = None  # --faults: the faults file the served twin meets
+    plc_faults: list[str] = field(default_factory=list)  # the faults the PLC reported, in order (names)
 
     @property
     def ok(self) -> bool:
@@ -106,6 +111,8 @@ class Summary:
     def exit_status(self) -> int:
         if self.remove_ring_at is not None:
             return 0 if self.fault_detected else 1
+        if self.faults is not None and self.stopped and self.plc_faults:
+            return 0  # the injected fault was reported by the PLC and the robot stopped
         return 0 if self.ok else 1
 
 
@@ -123,7 +130,8 @@ class CellDemo:
 
     def __init__(self, station: str | Path = DEFAULT_STATION, cycles: int = 1, *, realtime: bool = False,
                  speed: float = 1.0, remove_ring_at: int | None = None, scan_cycle: float = 0.010,
-                 out: Callable[[str], None] | None = None, record: str | Path | None = None):
+                 out: Callable[[str], None] | None = None, record: str | Path | None = None,
+                 faults: str | Path | None = None):
         if cycles < 1:
             raise ValueError("at least one cycle")
         if not (speed > 0 and scan_cycle > 0):
@@ -138,6 +146,7 @@ class CellDemo:
         self.requests = 0  # Modbus requests the PLC sent in the last run
         self.grip = ring_rig.cell_sequence()  # the gripper PLC
         self.record = record  # twin serve --record FILE: every signal and body pose at every step
+        self.faults = None if faults is None else Path(faults)  # twin serve --faults FILE: plant faults
 
     def say(self, who: str, text: str, t: float | None = None) -> None:
         """A narration line stamped with simulated time: `t` (the robot's own, from the server's log), else now."""
@@ -164,8 +173,10 @@ class CellDemo:
         mode = "lockstep: the PLC steps the twin" if not self.realtime else f"real time x{self.speed:g}"
         self.out(f"demo: {self.station.name}, {self.cycles} cycle(s), {mode}, PLC scan {self.scan_cycle * 1000:g} ms")
         extra = ["--record", str(self.record)] if self.record is not None else []
+        if self.faults is not None:
+            self.out(f"demo: the twin meets the faults of {self.faults}")
         with twin_server(self.station, lockstep=not self.realtime, speed=None if not self.realtime else self.speed,
-                         extra_args=extra) as server:
+                         extra_args=extra, faults=self.faults) as server:
             missing = [n for n in dict.fromkeys((*logic.inputs, *logic.outputs, *WATCH)) if n not in server.map]
             if missing:
                 raise DemoError(f"{self.station}: not a cell the demo can run: it has no {', '.join(missing)} "
@@ -180,7 +191,7 @@ class CellDemo:
                         inputs=tuple(dict.fromkeys((*logic.inputs, *WATCH))), speed=self.speed if self.realtime else 1.0)
         grip_state = plc.state[0]
         log = _LogTail(server.log)
-        s = Summary(self.cycles, remove_ring_at=self.remove_ring_at)
+        s = Summary(self.cycles, remove_ring_at=self.remove_ring_at, faults=None if self.faults is None else str(self.faults))
         cpu0 = (time.process_time(), _process_cpu(server.process.pid))
         wall0 = time.perf_counter()
         cycle_started: tuple[float, float] | None = None
@@ -198,6 +209,11 @@ class CellDemo:
             if grip_state.fault != seen["fault"]:
                 if grip_state.fault is Fault.BAD_REQUEST:
                     self._narrate_refusal(grip_state)
+                elif grip_state.fault in FINGER_FAULTS and grip_state.phase is not Phase.FAULT_MISSED:
+                    self.say("plc", f"FINGER FAULT while {'releasing' if grip_state.phase is Phase.FAULT_STUCK else 'preparing the fingers'}: "
+                                    f"{finger_fault_text(grip_state)}; axes held, fault to the robot")
+                if grip_state.fault is not Fault.NONE:
+                    s.plc_faults.append(grip_state.fault.name.lower())
                 seen["fault"] = grip_state.fault
             if image["goCyclesDone"] != seen["done"]:
                 seen["done"] = s.cycles_done = image["goCyclesDone"]
@@ -250,7 +266,17 @@ class CellDemo:
             s.misses += 1
             if s.ring_removed:
                 s.misses_after_removal += 1
-            self.say("plc", f"MISSED GRIP from {st.mode}: end of travel at {fingers} mm without force; fault to the robot")
+            if st.fault in FINGER_FAULTS:
+                self.say("plc", f"GRIP FAILED from {st.mode}: {finger_fault_text(st)}; fingers at {fingers} mm, "
+                                "axes held; fault to the robot")
+            elif st.fault is Fault.TIMEOUT:
+                self.say("plc", f"GRIP FAILED from {st.mode}: neither confirmed nor missed in time; fingers at "
+                                f"{fingers} mm; fault to the robot")
+            elif st.fault is Fault.LOST:
+                self.say("plc", f"RING LOST: a finger's force went away while holding it; fingers at {fingers} mm; "
+                                "grip withdrawn, fault to the robot")
+            else:
+                self.say("plc", f"MISSED GRIP from {st.mode}: end of travel at {fingers} mm without force; fault to the robot")
         elif st.phase is Phase.RELEASING:
             how = "closing out of the bore" if st.mode == INSIDE else "opening"
             self.say("plc", f"release: {how} until the ring is free")
@@ -258,7 +284,7 @@ class CellDemo:
             self.say("plc", f"RELEASE STUCK: the ring still touches a finger at {fingers} mm")
         elif st.phase is Phase.IDLE and before is Phase.RELEASING:
             self.say("plc", f"released: fingers at {fingers} mm")
-        elif st.phase is Phase.IDLE and before is Phase.PREPARING:
+        elif st.phase is Phase.IDLE and before is Phase.PREPARING and st.fault is Fault.NONE:
             self.say("plc", f"fingers ready at {fingers} mm")
 
     def _narrate_refusal(self, st) -> None:
@@ -288,6 +314,20 @@ class CellDemo:
         self.out(f"  ring            {ring}")
         if s.remove_ring_at is not None:
             self.out(f"  injected fault  {injected_fault_text(s)}")
+        if s.faults is not None:
+            found = ", ".join(dict.fromkeys(s.plc_faults)) or "none"
+            self.out(f"  injected faults {s.faults}: the PLC reported {found}"
+                     + ("; the robot stopped the cycle" if s.stopped else ""))
+
+
+FINGER_FAULTS = (Fault.JAMMED, Fault.DRIVE_LOST)
+
+
+def finger_fault_text(st) -> str:
+    """What the PLC found wrong with a finger, from its grip state (`plc_logic.CarefulState`)."""
+    what = "jammed (its drive pushes, it does not move)" if st.fault is Fault.JAMMED else "drive lost (it lags, its drive pushes with nothing)"
+    effort = "" if st.fault_effort is None else f", drive force {st.fault_effort:.0f} N"
+    return f"finger {st.fault_axis} {what}: {st.fault_lag:.1f} mm from its setpoint{effort}"
 
 
 def injected_fault_text(s: Summary) -> str:
@@ -343,7 +383,8 @@ def main(args) -> int:
         print(line, flush=True)
 
     demo = CellDemo(args.station, args.cycles, realtime=args.realtime, speed=args.speed,
-                    remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=record, out=out)
+                    remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=record, out=out,
+                    faults=args.faults)
     summary = demo.run()
     if args.report is not None:
         report(record, args.report, threshold=demo.grip.threshold, narration=lines,
@@ -353,7 +394,8 @@ def main(args) -> int:
 
 EXIT_STATUS_HELP = """exit status:
   0  every cycle was done and the ring is back within 5 mm of where it started;
-     with --remove-ring: the injected miss was detected and the robot stopped the cycle
+     with --remove-ring: the injected miss was detected and the robot stopped the cycle;
+     with --faults: as without, or the PLC reported a fault and the robot stopped the cycle
   1  otherwise (a cycle not done, the ring not back; with --remove-ring: the miss not detected,
      or the robot did not stop)
   2  bad arguments, or a station the demo cannot run"""
@@ -373,6 +415,9 @@ def add_arguments(p) -> None:
     p.add_argument("--remove-ring", type=positive_int, metavar="CYCLE", default=None,
                    help="take the ring out of the cell when this cycle starts (1..--cycles): a missed grip, "
                         "detected and reported; exit status 0 only if it is")
+    p.add_argument("--faults", metavar="FILE", default=None,
+                   help="plant faults for the served twin (twin serve --faults): [faults.NAME] tables as in a campaign "
+                        "(docs/campaigns.md), e.g. a finger jammed or its drive lost")
     p.add_argument("--scan", type=positive_float, metavar="S", default=0.010, help="PLC scan cycle, s (default 0.010)")
     p.add_argument("--record", metavar="FILE", default=None,
                    help="record every signal and body pose at every step (twin serve --record): .parquet or .csv")

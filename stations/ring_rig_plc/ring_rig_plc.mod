@@ -19,13 +19,16 @@ MODULE RingRigPlc
   !                 AO aoFingerReady   mm: where a prepare request puts the fingers
   !   PLC -> robot  DI diGripDone      the job of the request that is still high is over
   !                 DI diGripOk        the grip is confirmed: the ring is held
-  !                 DI diGripFault     missed grip (or a release that could not free it)
+  !                 DI diGripFault     a failed grip: missed, or a finger that does not follow
+  !                                    (jammed, drive lost); a held ring lost; a release that
+  !                                    could not free it; a preparation not done
   !   operator      DO movePickOutside, movePlaceOutside, movePickInside,
   !                    movePlaceInside, fullAutoRun   (the thesis's Init signals)
   !   robot -> cell GO goCycle         the number of the cycle running (or last run)
   !                 GO goCyclesDone    cycles completed
   !                 GO goMisses        missed grips seen by the robot
-  !                 DO doCycleFault    a cycle stopped on a missed pick
+  !                 DO doCycleFault    a cycle stopped: a missed pick, a finger fault, a ring
+  !                                    lost or not freed
   !***********************************************************************************
 
   PERS tooldata tcpGripper := [TRUE,[[0,0,350],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
@@ -159,25 +162,36 @@ MODULE RingRigPlc
     ENDWHILE
   ENDPROC
 
-  ! Go down with the ring, let the PLC release it, come straight back up.
+  ! Go down with the ring, let the PLC release it, come straight back up. A ring the PLC
+  ! no longer holds (it withdrew the grip: the ring slipped or fell) stops the cycle above
+  ! the place, and so does a release that could not free the ring.
   PROC PlaceRing(robtarget Approach,robtarget Place\switch Inside)
+    IF diGripOk=0 THEN
+      TPWrite "The gripper PLC no longer holds the ring";
+      SetDO doCycleFault,1;
+      SetDO fullAutoRun,0;
+      Stop;
+    ENDIF
     MoveL Place,v1000,fine,tcpGripper\WObj:=wobj0;
     AskGripper doReleaseRequest,"release";
     IF diGripFault=1 THEN
       TPWrite "The ring did not come free";
+      SetDO doCycleFault,1;
+      SetDO fullAutoRun,0;
       Stop;
     ENDIF
     bHolding := FALSE;
     MoveL Approach,v1000,fine,tcpGripper\WObj:=wobj0;
   ENDPROC
 
-  ! The PLC puts the fingers at Position (mm) before the robot goes down; a refused
-  ! preparation stops the cycle, so the robot never goes down with the fingers elsewhere.
+  ! The PLC puts the fingers at Position (mm) before the robot goes down; a preparation it
+  ! refuses, or one a finger does not follow (jammed, its drive lost), stops the cycle, so
+  ! the robot never goes down with the fingers elsewhere.
   PROC FingersReady(num Position)
     SetAO aoFingerReady,Position;
     AskGripper doPrepare,"finger preparation";
     IF diGripFault=1 THEN
-      TPWrite "The gripper PLC refused to put the fingers at "+NumToStr(Position,0)+" mm";
+      TPWrite "The gripper PLC could not put the fingers at "+NumToStr(Position,0)+" mm";
       SetDO doCycleFault,1;
       SetDO fullAutoRun,0;
       Stop;

@@ -40,7 +40,8 @@ def test_the_demo_help_says_what_the_exit_status_means():
     assert r.returncode == 0
     text = " ".join(r.stdout.split())
     assert "exit status: 0 every cycle was done and the ring is back within 5 mm of where it started; " \
-           "with --remove-ring: the injected miss was detected and the robot stopped the cycle 1 otherwise" in text
+           "with --remove-ring: the injected miss was detected and the robot stopped the cycle; " \
+           "with --faults: as without, or the PLC reported a fault and the robot stopped the cycle 1 otherwise" in text
 
 
 def test_importing_the_demo_does_not_import_the_pytest_plugin():
