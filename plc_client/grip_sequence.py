@@ -58,7 +58,7 @@ class Fault(IntEnum):
     MISSED = 1  # end of travel reached without the force threshold: no part between the fingers
     STUCK = 2  # release limit reached with the part still touching
     BAD_REQUEST = 3  # a prepare request to a position outside the axes' travel (or with none): refused
-    # raised by sequences that also watch their fingers (e.g. the ring rig's `CarefulGripSequence`):
+    # raised by sequences that also watch their fingers (a subclass that compares setpoints and positions):
     JAMMED = 4  # a finger does not follow its setpoint while its drive pushes hard: blocked
     DRIVE_LOST = 5  # a finger does not follow its setpoint and its drive pushes with (almost) nothing
     TIMEOUT = 6  # a grip neither confirmed nor missed within its time
