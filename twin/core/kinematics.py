@@ -79,6 +79,9 @@ class ArmKinematics:
             self.body = self.client.loadURDF(str(self.urdf_path), self.base.position.tolist(),
                                              self.base.orientation.tolist(), useFixedBase=True,
                                              flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+        from .world import bind_calls
+
+        bind_calls(self.client)  # (forward kinematics is asked at every step while the robot settles)
         c = self.client
         by_name: dict[str, int] = {}
         links: dict[str, int] = {}

@@ -55,6 +55,7 @@ class Robot:
         self._settled = True
         self._held = None
         self._motors = client.setJointMotorControlArray  # bound once: called at every physics substep
+        self._joint_states = client.getJointStates
         self._hold = self.q
         self._paused: np.ndarray | None = None  # while paused: where the arm holds
 
@@ -63,6 +64,10 @@ class Robot:
     def q(self) -> np.ndarray:
         """Actual joint positions (rad)."""
         return np.array([s[0] for s in self.client.getJointStates(self.body, self.joints)])
+
+    def positions(self) -> list[float]:
+        """Actual joint positions (rad) as floats: `q` without the array, for publishing at every step."""
+        return [s[0] for s in self._joint_states(self.body, self.joints)]
 
     @property
     def qd(self) -> np.ndarray:

@@ -219,8 +219,8 @@ class Twin:
             out[status_key] = finger.status
         if self.robot is not None:
             out["robot.busy"] = self.robot.busy(self.time)
-            for key, q in zip(self._robot_keys, self.robot.q):
-                out[key] = float(q)
+            for key, q in zip(self._robot_keys, self.robot.positions()):
+                out[key] = q
         pose = self.world.client.getBasePositionAndOrientation
         for uid, x_key, y_key, z_key in self._target_keys:
             out[x_key], out[y_key], out[z_key] = pose(uid)[0]

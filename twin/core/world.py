@@ -181,7 +181,8 @@ def create_body(c, body: Body) -> int:
 
 HOT_CALLS = ("stepSimulation", "getJointStates", "getJointState", "setJointMotorControlArray", "getContactPoints",
              "getClosestPoints", "getAABB", "getOverlappingObjects", "getLinkState", "getBasePositionAndOrientation",
-             "resetBasePositionAndOrientation", "invertTransform", "multiplyTransforms", "getJointInfo")
+             "resetBasePositionAndOrientation", "invertTransform", "multiplyTransforms", "getJointInfo",
+             "resetJointState", "getBaseVelocity", "resetBaseVelocity")
 
 
 def bind_calls(client: BulletClient) -> None:
