@@ -63,6 +63,7 @@ class Fault(IntEnum):
     DRIVE_LOST = 5  # a finger does not follow its setpoint and its drive pushes with (almost) nothing
     TIMEOUT = 6  # a grip neither confirmed nor missed within its time
     LOST = 7  # a held part's force went away: the part is no longer held
+    FORCE_READING = 8  # a finger on the part, its drive pushing hard, reads no force: its force sensor is wrong
 
 
 @dataclass(frozen=True)

@@ -320,12 +320,14 @@ class CellDemo:
                      + ("; the robot stopped the cycle" if s.stopped else ""))
 
 
-FINGER_FAULTS = (Fault.JAMMED, Fault.DRIVE_LOST)
+FINGER_FAULTS = (Fault.JAMMED, Fault.DRIVE_LOST, Fault.FORCE_READING)
 
 
 def finger_fault_text(st) -> str:
     """What the PLC found wrong with a finger, from its grip state (`plc_logic.CarefulState`)."""
-    what = "jammed (its drive pushes, it does not move)" if st.fault is Fault.JAMMED else "drive lost (it lags, its drive pushes with nothing)"
+    what = {Fault.JAMMED: "jammed (its drive pushes, it does not move)",
+            Fault.DRIVE_LOST: "drive lost (it lags, its drive pushes with nothing)",
+            Fault.FORCE_READING: "force reading wrong (it presses on the ring, its drive pushes, it reads no force)"}[st.fault]
     effort = "" if st.fault_effort is None else f", drive force {st.fault_effort:.0f} N"
     return f"finger {st.fault_axis} {what}: {st.fault_lag:.1f} mm from its setpoint{effort}"
 

@@ -196,11 +196,16 @@ class CarefulGripSequence(GripSequence):
     def _finger_fault(self, inputs: Mapping, state: CarefulState, axis: str, actual: dict) -> None:
         """A finger that does not follow: jammed if it stood still while its drive pushed hard (or, without
         drive-force signals, if it stood still), else its drive is lost (it pushes with little, or the
-        finger goes where it is pushed)."""
-        effort = None if self.efforts is None else abs(float(inputs[self.efforts[self.axes.index(axis)]]))
+        finger goes where it is pushed). Jammed on the part itself (its contact set) with a force reading
+        below the threshold: its force reading is wrong (`Fault.FORCE_READING`)."""
+        i = self.axes.index(axis)
+        effort = None if self.efforts is None else abs(float(inputs[self.efforts[i]]))
         still = abs(actual[axis] - state.stall_from.get(axis, actual[axis])) < self.max_lag / 6.0  # (0.5 mm)
         pushing = effort is None or effort >= self.blocked_effort
         kind = Fault.JAMMED if still and pushing else Fault.DRIVE_LOST
+        if (kind is Fault.JAMMED and self.per_finger and self.contacts and bool(inputs[self.contacts[i]])
+                and float(inputs[self.forces[i]]) < self.threshold):
+            kind = Fault.FORCE_READING  # it is on the part and pushes hard, yet its force reading says otherwise
         state.fault_axis, state.fault_lag, state.fault_effort = axis, abs(state.setpoint[axis] - actual[axis]), effort
         self._fail(state, kind, actual)
 

@@ -28,7 +28,7 @@ def test_it_covers_offsets_sizes_a_missing_ring_a_jammed_finger_a_dead_drive_and
     assert any(p.get("ring.offset_x_mm") for p in params) and any(p.get("ring.offset_y_mm") for p in params)
     assert any("ring.outer_diameter_mm" in p for p in params)
     kinds = {c.faults[p["fault"]].kind for p in params if p.get("fault", "none") != "none"}
-    assert kinds == {"part_missing", "finger_jammed", "finger_force_lost", "link_lost"}
+    assert kinds == {"part_missing", "finger_jammed", "finger_force_lost", "force_stuck", "link_lost"}
     timeout = robot_plc_timeout()
     for sc in c.scenarios:  # every scenario says what the PLC must reach
         exp = expectations(c, sc)
@@ -38,6 +38,8 @@ def test_it_covers_offsets_sizes_a_missing_ring_a_jammed_finger_a_dead_drive_and
             assert exp["outcome"] == "stopped" and exp["fault"] == "cycle_fault"
             assert exp["plc_fault"] in ("jammed", "drive_lost", "lost")
             assert exp["cycle_time_max"] < timeout / 2
+        elif kind == "force_stuck":  # a finger reading no force: never a grip, the sensor named
+            assert (exp["outcome"], exp["grips"], exp["plc_fault"]) == ("stopped", 0, "force_reading")
         elif kind == "part_missing":  # no grip confirmed, the miss detected twice, the cycle stopped
             assert (exp["outcome"], exp["fault"], exp["grips"], exp["grip"], exp["plc_fault"]) == (
                 "stopped", "cycle_fault", 0, "missed", "missed")

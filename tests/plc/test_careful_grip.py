@@ -9,7 +9,7 @@ from plc_client.grip_sequence import Fault, Phase
 from plc_client.link import LinkFaults
 from plc_client.scan import ScanCycle
 from tests.plc.conftest import BENCH, RING_FORCES, Bench, ring_sequence
-from twin.faults import DriveForceLost, FaultInjector, FingerJammed
+from twin.faults import DriveForceLost, FaultInjector, FingerJammed, ReadingStuck
 
 
 def test_a_slow_drive_is_waited_for_not_taken_for_a_fault(bench):
@@ -88,3 +88,14 @@ def test_a_jam_on_the_bench_is_named_with_its_finger_and_the_ring_stays_put(benc
     assert bench.io.get("L4.actual") == pytest.approx(326.0, abs=0.3)
     end = bench.twin.object_pose("ring")[0]
     assert sum((a - b) ** 2 for a, b in zip(start, end)) ** 0.5 < 0.002  # m: the ring was not pushed into the jam
+
+
+def test_a_force_reading_stuck_at_zero_never_confirms_and_names_the_sensor(bench):
+    FaultInjector.attach(bench.twin, [ReadingStuck(signal="L3.force", value=0.0)])
+    bench.request("grip_request")
+    image = bench.wait(Phase.HELD, Phase.FAULT_MISSED)
+    st = bench.plc.state
+    assert st.phase is Phase.FAULT_MISSED and (st.fault, st.fault_axis) == (Fault.FORCE_READING, "L3")
+    # the physics: finger 2 does press on the ring (its true force), only its reading says 0 N
+    assert image["L3.contact"] and image["L3.force"] == 0.0
+    assert bench.twin.finger_forces()["L3"] >= 200.0
