@@ -34,6 +34,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import socket
 import sys
 import time
 from dataclasses import dataclass, field
@@ -237,7 +238,7 @@ class CellDemo:
             if self.now > limit:
                 self.say("demo", f"gave up: the cycles did not end within {limit:g} s of simulated time")
                 break
-        for t, line in log.lines():
+        for t, line in log.lines_until_now(server.host, server.port):
             self.say("robot", line, t)
         self.scans, self.requests = plc.scans, client.requests
         self.cpu = (time.process_time() - cpu0[0], _process_cpu(server.process.pid) - cpu0[1])  # PLC, twin serve
@@ -354,6 +355,28 @@ class _LogTail:
 
     def lines(self) -> list[tuple[float | None, str]]:
         """(simulated time the server stamped, text) of each new robot line."""
+        return [robot for line in self._new_lines() if (robot := _robot_line(line))]
+
+    def lines_until_now(self, host: str, port: int, timeout: float = 10.0) -> list[tuple[float | None, str]]:
+        """Every robot line the server logged up to now, including those its log thread has not written yet.
+
+        The server's log is one queue written in order: a connection opened now is logged after every line
+        of the steps already run, so once that line is in the file, so is everything before it."""
+        with socket.create_connection((host, port), timeout=timeout) as probe:
+            own_host, own_port = probe.getsockname()[:2]
+        marker = f"client {own_host}:{own_port} connected"
+        found, deadline = [], time.monotonic() + timeout
+        while True:
+            for line in self._new_lines():
+                if marker in line:
+                    return found
+                if robot := _robot_line(line):
+                    found.append(robot)
+            if time.monotonic() > deadline:  # a server logging below info: what is there is all we get
+                return found
+            time.sleep(0.01)
+
+    def _new_lines(self) -> list[str]:
         with open(self.path, "r", encoding="utf-8", errors="replace") as f:
             f.seek(self.offset)
             text = f.read()
@@ -361,14 +384,16 @@ class _LogTail:
         text, self.rest = self.rest + text, ""
         if text and not text.endswith("\n"):
             text, _, self.rest = text.rpartition("\n")
-        found = []
-        for line in text.splitlines():
-            # "twin serve: [t=2.064 s] robot: Gripped ..." -> (2.064, "Gripped ...")
-            head, sep, tail = line.partition("] robot")
-            if sep:
-                stamp = re.search(r"\[t=\s*([0-9.]+) s$", head)
-                found.append((float(stamp.group(1)) if stamp else None, tail.lstrip(": ").strip()))
-        return found
+        return text.splitlines()
+
+
+def _robot_line(line: str) -> tuple[float | None, str] | None:
+    """"twin serve: [t=2.064 s] robot: Gripped ..." -> (2.064, "Gripped ..."); None for other lines."""
+    head, sep, tail = line.partition("] robot")
+    if not sep:
+        return None
+    stamp = re.search(r"\[t=\s*([0-9.]+) s$", head)
+    return float(stamp.group(1)) if stamp else None, tail.lstrip(": ").strip()
 
 
 def main(args) -> int:
