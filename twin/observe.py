@@ -150,7 +150,7 @@ class Observer:
         self._base_pose_t = tuple(float(v) for v in self._base_pose)
         self._other_ids = [uid for _, uid in self._others]
         self._cid = c._client  # the connection's id (BulletClient keeps it here)
-        import pybullet
+        from twin.core.bullet import pybullet
 
         self._pb = pybullet
 

@@ -66,7 +66,7 @@ def _body_position(twin, key: str):
 def render(twin, *, width: int = 960, height: int = 720, focus: str | None = None, highlight: str = "",
            distance: float | None = None) -> np.ndarray:
     """An RGB picture (height x width x 3, uint8) of the twin's world as it is now."""
-    import pybullet
+    from twin.core.bullet import pybullet
 
     c = twin.world.client
     restore = []

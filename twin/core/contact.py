@@ -9,8 +9,7 @@ still change a pybullet world's results), so replays stay bit-identical.
 """
 from __future__ import annotations
 
-import pybullet
-from pybullet_utils.bullet_client import BulletClient
+from .bullet import BulletClient, pybullet
 
 from .native_output import quiet_native_output
 

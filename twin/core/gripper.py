@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import pybullet
+from .bullet import pybullet
 
 from .errors import SignalRangeError
 from .mechanism import JointInput, Mechanism

@@ -19,8 +19,7 @@ from pathlib import Path
 from typing import Iterable, Sequence
 
 import numpy as np
-import pybullet
-from pybullet_utils.bullet_client import BulletClient
+from .bullet import BulletClient, pybullet
 
 from .errors import MotionError
 from .geometry import Pose, quat_conj, quat_mul

@@ -14,7 +14,7 @@ import math
 from typing import Iterable, Sequence
 
 import numpy as np
-import pybullet
+from .bullet import pybullet
 
 from .errors import MotionError
 from .geometry import Pose

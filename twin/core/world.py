@@ -20,8 +20,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import pybullet
-from pybullet_utils.bullet_client import BulletClient
+from .bullet import BulletClient, pybullet
 
 from .errors import StationError
 from .mechanism import NOT_DRIVEN
