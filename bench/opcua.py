@@ -29,7 +29,6 @@ import argparse
 import asyncio
 import os
 import re
-import statistics
 import subprocess
 import sys
 import threading
@@ -37,13 +36,16 @@ import time
 from datetime import datetime, timezone
 from pathlib import Path
 
+from bench.modbus_latency import Server
+
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_STATION = ROOT / "stations" / "ring_rig"
 UNIT = 1
 
 
-class TwinServer:
-    """`twin serve STATION --opcua 0 --port 0` in real time; its Modbus port and OPC UA endpoint from its log."""
+class TwinServer(Server):
+    """`twin serve STATION --opcua 0 --port 0` in real time; its Modbus port and OPC UA endpoint from its log
+    (started here; stopped as bench modbus stops its servers)."""
 
     def __init__(self, station: Path):
         cert_dir = ROOT / ".pytest_cache" / "bench-opcua-certs"
@@ -76,14 +78,6 @@ class TwinServer:
         fields = Path(f"/proc/{self.proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
         return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
 
 
 def pct(values: list[float], q: float) -> float:

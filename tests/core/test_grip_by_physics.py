@@ -11,6 +11,7 @@ import pytest
 from tests.conftest import ROOT, STATIONS
 from twin.core import Twin
 from twin.core.errors import StationError
+from tests.station_copies import edited_station
 
 RING_RIG = STATIONS / "ring_rig"
 G = 9.81
@@ -183,13 +184,7 @@ def test_contact_turns_on_within_half_a_millimetre_of_true_contact_and_never_bef
 
 # -- newcomer traps --------------------------------------------------------------------------------------------
 def four_finger_with(tmp_path, old: str, new: str):
-    folder = tmp_path / "four"
-    shutil.copytree(STATIONS / "four_finger", folder)
-    toml = folder / "station.toml"
-    text = toml.read_text()
-    assert old in text
-    toml.write_text(text.replace(old, new))
-    return folder
+    return edited_station(STATIONS / "four_finger", tmp_path / "four", old, new)
 
 
 def test_a_target_overlapping_a_finger_at_the_start_is_an_error_naming_both(tmp_path):

@@ -23,13 +23,7 @@ class ServerProcess:
 
     def __init__(self, station: Path, *args: str, drain: bool = True, port: str = "0"):
         """`drain=False`: stderr is read up to the `listening on` line(s), then nobody reads the pipe."""
-        self.cmd = [sys.executable, "-m", "twin", "serve", str(station), "--port", port, *args]
-        self.proc = subprocess.Popen(self.cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                     cwd=ROOT, env={**os.environ, "PYTHONUNBUFFERED": "1"})
-        self.lines: list[str] = []
-        self._seen = threading.Condition()
-        self.drain = drain
-        threading.Thread(target=self._drain, daemon=True).start()
+        self._start([sys.executable, "-m", "twin", "serve", str(station), "--port", port, *args], drain=drain)
         self.tls_port = None
         if "--tls-cert" in self.cmd:
             self.tls_port = int(self.wait_for(r"listening on [\d.]+:(\d+) \(Modbus/TCP Security", timeout=30).group(1))
@@ -38,8 +32,17 @@ class ServerProcess:
             m = self.wait_for(r"listening on ([\d.]+):(\d+)$", timeout=30)
             self.host, self.port = m.group(1), int(m.group(2))
 
+    def _start(self, cmd: list[str], drain: bool = True, env: dict[str, str] | None = None) -> None:
+        """Start `cmd` (a `twin serve` command line) and collect its stderr in `lines` from a thread."""
+        self.cmd, self.drain = cmd, drain
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                     cwd=ROOT, env={**os.environ, "PYTHONUNBUFFERED": "1", **(env or {})})
+        self.lines: list[str] = []
+        self._seen = threading.Condition()
+        threading.Thread(target=self._drain, daemon=True).start()
+
     def _drain(self) -> None:
-        drain = getattr(self, "drain", True)  # subclasses that build their own process drain everything
+        drain = self.drain
         listening = 0
         want = 2 if "--tls-cert" in self.cmd and "--tls-only" not in self.cmd else 1
         for line in self.proc.stderr:

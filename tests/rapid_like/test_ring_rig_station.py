@@ -6,13 +6,13 @@ gripper's doGripped and aiAxis1..3 to the actual finger positions; motions drive
 from __future__ import annotations
 
 import math
-import shutil
 
 import pytest
 
 from tests.conftest import STATIONS
 from twin_app.cell import open_cell
 from twin.core.errors import StationError
+from tests.station_copies import edited_station
 
 RIG = STATIONS / "ring_rig"
 RIGHT, LEFT = (1.6, -0.8), (1.6, 0.8)
@@ -71,14 +71,7 @@ def test_init_waits_for_a_path_signal_like_the_io_simulator():
 
 def copy_rig(tmp_path, old: str | None = None, new: str | None = None):
     """A copy of the rig in `tmp_path`, its station.toml with `old` replaced by `new`."""
-    shutil.copytree(STATIONS / "robots", tmp_path / "robots")
-    station = shutil.copytree(RIG, tmp_path / "rig")
-    if old is not None:
-        toml = station / "station.toml"
-        text = toml.read_text()
-        assert old in text
-        toml.write_text(text.replace(old, new))
-    return station
+    return edited_station(RIG, tmp_path / "rig", old, new)
 
 
 def test_wiring_to_a_signal_the_twin_lacks_names_the_file_and_key(tmp_path):
