@@ -25,23 +25,33 @@ GENERAL_PACKAGES = ("twin", "twin_app", "plc_client", "rapid_like")
 SHIPPED_STATIONS = Path(__file__).resolve().parent.parent / "stations"
 
 
-def moved_modules() -> dict[str, str]:
-    """old module name -> new one, from every shipped station file's `[plugins] moved` (read once)."""
-    global _moved
-    if _moved is None:
-        table: dict[str, str] = {}
+def shipped_plugin_tables() -> dict[Path, dict]:
+    """Each shipped station folder -> its station file's `[plugins]` table, read once, without loading the
+    station (a plain look into the TOML; a file that does not parse is left out: loading it says why)."""
+    global _tables
+    if _tables is None:
+        _tables = {}
         for toml in sorted(SHIPPED_STATIONS.glob("*/station.toml")):
             try:
-                moved = tomllib.loads(toml.read_text(encoding="utf-8")).get("plugins", {}).get("moved", {})
-            except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, AttributeError):
+                plugins = tomllib.loads(toml.read_text(encoding="utf-8")).get("plugins", {})
+            except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
                 continue
-            if isinstance(moved, dict):
-                table.update({str(k): str(v) for k, v in moved.items()})
-        _moved = table
-    return _moved
+            if isinstance(plugins, dict):
+                _tables[toml.parent] = plugins
+    return _tables
 
 
-_moved: dict[str, str] | None = None
+_tables: dict[Path, dict] | None = None
+
+
+def moved_modules() -> dict[str, str]:
+    """old module name -> new one, from every shipped station file's `[plugins] moved`."""
+    table: dict[str, str] = {}
+    for plugins in shipped_plugin_tables().values():
+        moved = plugins.get("moved", {})
+        if isinstance(moved, dict):
+            table.update({str(k): str(v) for k, v in moved.items()})
+    return table
 
 
 class _Alias(importlib.abc.Loader):

@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 
 from .core.errors import StationError
-from .moved import SHIPPED_STATIONS  # the ready cells installed with the project
+from .moved import SHIPPED_STATIONS, shipped_plugin_tables  # the ready cells installed with the project
 
 
 
@@ -87,17 +87,7 @@ def station_plugin(station, key: str):
 def shipped_stations_with(key: str) -> list[Path]:
     """The shipped station folders whose station file names a `key` plug-in (read without loading the
     station: a plain look into the TOML)."""
-    import tomllib
-
-    found = []
-    for toml in sorted(SHIPPED_STATIONS.glob("*/station.toml")):
-        try:
-            plugins = tomllib.loads(toml.read_text(encoding="utf-8")).get("plugins", {})
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-            continue
-        if isinstance(plugins, dict) and key in plugins:
-            found.append(toml.parent)
-    return found
+    return [folder for folder, plugins in shipped_plugin_tables().items() if key in plugins]
 
 
 def shipped_station_with(key: str) -> Path:
