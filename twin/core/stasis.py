@@ -19,6 +19,8 @@ a part settles on its support within a micrometre rather than bit for bit as it 
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+
 REST_SPEED = 1e-5  # m/s: a body slower than this is at rest
 REST_SPIN = 1e-4  # rad/s
 REST_STEPS = 25  # steps (0.3 s at 12 ms) the cell has to stay at rest before it is frozen (CHECK_EVERY's multiple)
@@ -33,27 +35,28 @@ class Stasis:
 
     def __init__(self, client, machine: int, loose: list[int]):
         self.client, self.machine = client, machine
-        self.loose = [uid for uid in loose]  # dynamic targets and fixtures, station order
+        self.loose = list(loose)  # dynamic targets and fixtures, station order
         self._loose = set(self.loose)
         self.frozen: dict[int, tuple] = {}  # body -> (its mass, its pose and velocity when frozen)
         self._resting = 0  # steps in a row the cell has been at rest
 
-    def before_physics(self, machine_still: bool) -> None:
-        """Thaw every frozen body unless the machine stands still and no frozen body was moved from outside."""
+    def before_physics(self, machine_still: Callable[[], bool]) -> None:
+        """Thaw every frozen body unless the machine stands still and no frozen body was moved from outside.
+        (`machine_still` is asked only while something is frozen: most steps need no answer.)"""
         if not self.frozen:
             return
-        if machine_still:
+        if machine_still():
             c = self.client
             if all(c.getBasePositionAndOrientation(uid) == pose and c.getBaseVelocity(uid) == STANDING
                    for uid, (_, pose, _) in self.frozen.items()):
                 return
         self.thaw()
 
-    def after_step(self, machine_still: bool) -> None:
+    def after_step(self, machine_still: Callable[[], bool]) -> None:
         """Count the steps the cell has rested; freeze the loose bodies once it has rested REST_STEPS."""
         if self.frozen or not self.loose:
             return
-        if not machine_still:
+        if not machine_still():
             self._resting = 0
             return
         self._resting += 1

@@ -128,13 +128,13 @@ class Twin:
                 if robot is not None:
                     robot.update(t + k * h)
                 if k == 0:  # a cell at rest has its loose bodies frozen: thawed before anything may move them
-                    world.stasis.before_physics(self._machine_still())
+                    world.stasis.before_physics(self._machine_still)
                 world.substep_physics()
                 gripper.measure(k == world.substeps - 1)
             self.step_count += 1
             self.gripper.sense()
             self._publish()
-            world.stasis.after_step(self._machine_still())
+            world.stasis.after_step(self._machine_still)
             for device in self.devices:
                 device.after_step(self)
 
