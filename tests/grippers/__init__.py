@@ -1,0 +1,50 @@
+"""Five grippers nobody tuned (issue 18), written from docs/station-format.md alone, each a station folder here:
+
+- `newcomer_2f`: a newcomer's 2-finger gripper on the shipped arm, two independent 40 N prismatic fingers of 20 g,
+  a 30 mm can (42 g); variants on a 36 g box (`newcomer_2f_box`) and a 300 g steel cylinder (`newcomer_2f_steel`);
+- `parallel_200n`: a 200 N parallel gripper, one input, the second jaw a 1:1 mimic (100 N per jaw), a 0.34 kg block;
+- `revolute_chuck`: a 3-jaw chuck of 2 N m revolute levers on a 0.23 kg disc from outside, and into the bore of a
+  2.2 kg ring (`revolute_chuck_bore`);
+- `light_5n`: a gantry lift carrying two 5 N fingers of 8 g, a 10 g cube;
+- `sloppy_inertia`: a CAD export with 1 kg m^2 inertias on 50 g fingers, two 50 N fingers, a 0.14 kg cylinder.
+
+`GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
+grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
+what statics says each finger presses with then (N, or N m for a revolute finger).
+"""
+from dataclasses import dataclass
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
+         "revolute_chuck_bore", "light_5n", "sloppy_inertia")
+GRIPPERS = {name: HERE / name for name in NAMES}
+
+
+@dataclass(frozen=True)
+class Grip:
+    part: str
+    close: dict  # input -> setpoint past the part (every finger at its force limit)
+    force: dict  # finger -> what statics says it presses with (its drive's effort; half of it for a 1:1 mimic pair)
+    closing: str = "outside"  # "outside" (status 2 when stalled) or "inside" (into a bore: status 1)
+
+
+GRIPS = {
+    "newcomer_2f": Grip("can", {"finger_left": 0.005, "finger_right": 0.005}, {"finger_left": 40.0, "finger_right": 40.0}),
+    "newcomer_2f_box": Grip("box", {"finger_left": 0.005, "finger_right": 0.005},
+                            {"finger_left": 40.0, "finger_right": 40.0}),
+    "newcomer_2f_steel": Grip("slug", {"finger_left": 0.0025, "finger_right": 0.0025},
+                              {"finger_left": 40.0, "finger_right": 40.0}),
+    "parallel_200n": Grip("block", {"jaw_a": 0.015}, {"jaw_a": 100.0, "jaw_b": 100.0}),
+    "revolute_chuck": Grip("disc", {"jaw_1": -0.3, "jaw_2": -0.3, "jaw_3": -0.3}, {"jaw_1": 2.0, "jaw_2": 2.0, "jaw_3": 2.0}),
+    "revolute_chuck_bore": Grip("ring", {"jaw_1": 0.3, "jaw_2": 0.3, "jaw_3": 0.3},
+                                {"jaw_1": 2.0, "jaw_2": 2.0, "jaw_3": 2.0}, "inside"),
+    "light_5n": Grip("cube", {"jaw_left": 0.005, "jaw_right": 0.005}, {"jaw_left": 5.0, "jaw_right": 5.0}),
+    "sloppy_inertia": Grip("cylinder", {"finger_1_link": 0.015, "finger_2_link": 0.015},
+                           {"finger_1_link": 50.0, "finger_2_link": 50.0}),
+}
+
+
+def station(name: str) -> Path:
+    """The station folder of test gripper `name`."""
+    return GRIPPERS[name]
