@@ -64,7 +64,7 @@ def _body_position(twin, key: str):
 
 
 def render(twin, *, width: int = 960, height: int = 720, focus: str | None = None, highlight: str = "",
-           distance: float | None = None) -> np.ndarray:
+           distance: float | None = None, yaw: float = 35.0, pitch: float = -28.0) -> np.ndarray:
     """An RGB picture (height x width x 3, uint8) of the twin's world as it is now."""
     from twin.core.bullet import pybullet
 
@@ -76,7 +76,7 @@ def render(twin, *, width: int = 960, height: int = 720, focus: str | None = Non
             restore.append((uid, v[1], v[7]))
         c.changeVisualShape(uid, -1, rgbaColor=HIGHLIGHT)
     try:
-        view, proj = camera(twin, focus, width=width, height=height, distance=distance)
+        view, proj = camera(twin, focus, width=width, height=height, distance=distance, yaw=yaw, pitch=pitch)
         _, _, rgba, _, _ = c.getCameraImage(width, height, viewMatrix=view, projectionMatrix=proj,
                                             renderer=pybullet.ER_TINY_RENDERER, shadow=1,
                                             lightDirection=[-1.0, -2.0, 4.0], lightAmbientCoeff=0.55,

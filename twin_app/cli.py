@@ -5,6 +5,7 @@
     twin map STATION [--format json|csv|md]
     twin demo [STATION] [OPTIONS]  (a station's demo: its station.toml's [plugins] twin_demo)
     twin campaign ... (twin_app.campaign)
+    twin check STATION [-o grip.png] [--json FILE] [--hold S]  (the station doctor: twin.doctor)
 
 `serve` assembles the cell (`twin_app.cell.Cell`) and plugs its front ends in (Modbus/TCP:
 `twin.modbus.front_end`). It logs to stderr through `twin.modbus.log`: a line when it starts loading the
@@ -23,6 +24,7 @@ import signal
 import sys
 from pathlib import Path
 
+from twin.cli_args import positive_float
 from twin.core.errors import TwinError
 from twin.modbus.cli import add_commands as add_modbus_commands, tls_from_args
 from twin.modbus.log import announce, log as _log
@@ -86,6 +88,22 @@ def cmd_demo(args) -> int:
     from twin.plugins import run_station_demo
 
     return run_station_demo("twin_demo", args.demo_options, prog="twin demo", positional=True)
+
+
+def cmd_check(args) -> int:
+    """The station doctor: exit 0 when every check passes (warnings allowed), 1 when one fails."""
+    from twin.doctor import check_station, format_report, save_pictures
+
+    if args.output and Path(args.output).suffix.lower() != ".png":
+        print(f"twin check: error: -o {args.output}: the picture is a .png", file=sys.stderr)
+        return 2
+    report, pictures = check_station(args.station, hold=args.hold, picture=bool(args.output))
+    print(format_report(report))
+    if args.output and pictures:
+        print(f"picture: {save_pictures(pictures, args.output)}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(report.as_dict(), indent=2) + "\n", encoding="utf-8")
+    return 1 if report.failed else 0
 
 
 def controller_log(event: dict) -> None:
@@ -229,6 +247,18 @@ def build_parser() -> argparse.ArgumentParser:
                        "station.toml's [plugins] twin_demo; without STATION, the shipped one; `twin demo --help` lists "
                        "its options)")
     p.set_defaults(func=cmd_demo, takes_options=True)
+    p = sub.add_parser("check", help="the station doctor: grip every target, measure contacts, forces, noise, creep "
+                       "and friction capacity against the thresholds of a ready gripper (exit 1 if one fails)",
+                       description="Grip every target of the station (from outside, and into a bore where the "
+                                   "geometry allows), lift it where the station has a robot, and judge each finger "
+                                   "(docs/check.md). Exit 0: every check passes (warnings allowed); 1: one fails; "
+                                   "2: bad usage or a station that does not load.")
+    p.add_argument("station", help="a station folder or station.toml")
+    p.add_argument("-o", "--output", metavar="PNG", default=None, help="write a picture of each grip (side by side)")
+    p.add_argument("--json", metavar="FILE", default=None, help="also write the full report as JSON")
+    p.add_argument("--hold", type=positive_float, default=5.0, metavar="S",
+                   help="seconds a part rests and is held at rest for the creep checks (default 5)")
+    p.set_defaults(func=cmd_check)
     from .campaign.cli import add_command as add_campaign
 
     add_campaign(sub)
