@@ -23,6 +23,7 @@ import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from .core.errors import MotionError
 from .core.geometry import Pose
 
 PASS, WARN, FAIL, INFO = "PASS", "WARN", "FAIL", "INFO"
@@ -277,9 +278,6 @@ class Doctor:
         self.fingers = list(self.g.finger_links)
         self.spec = {t.name: t for t in st.targets}
         self.unit = {i.name: i.unit for i in self.mech.inputs}
-        self.joint_type = {}
-        for f in self.mech.fingers:
-            self.joint_type[f.name] = "rad" if f.name in self.g.revolute_fingers else "m"
 
     # -- helpers ----------------------------------------------------------------------------------
     def check(self, level, where, who, measure, text) -> None:
@@ -380,7 +378,12 @@ class Doctor:
             for mode in ("outside", "inside"):
                 result = GripResult(body.name, mode)
                 self.report.grips.append(result)
-                self.grip(body.name, mode, plans, drive_of, result)
+                try:
+                    self.grip(body.name, mode, plans, drive_of, result)
+                except MotionError as exc:  # the arm cannot get there: the grip is not possible as placed
+                    result.skipped = result.skipped or "the robot cannot get there"
+                    self.check(FAIL, f"{body.name} {mode}", "robot", "motion", str(exc))
+                    return self.report
         return self.report
 
     def rest(self) -> None:
@@ -538,7 +541,6 @@ class Doctor:
             tw.step()
             for f in fingers:
                 status[f].append(int(tw.read(f"{f}.status")))
-        k_window = tw.step_count - t0
         # the hold: every step's positions, forces, overlap, status; the part relative to the gripper
         n = self.steps(self.hold)
         pos = {f: [] for f in fingers}
@@ -589,9 +591,9 @@ class Doctor:
             r.expected_force = g.drives[d].effort * self.linkage_share(f, d, fingers)
         result.weight = self.weight(name)
         result.capacity = mu * sum(r.normal_force for r in res.values())
-        self.judge(where, want, status, k_window, res, moving, result, mu)
+        self.judge(where, want, status, res, moving, result, mu)
 
-    def judge(self, where, want, status, k_window, res, moving, result, mu) -> None:
+    def judge(self, where, want, status, res, moving, result, mu) -> None:
         for f, r in res.items():
             if r.onset_step is None:
                 self.check(FAIL, where, f, "contact", f"never touched the part (geometry: contact at "

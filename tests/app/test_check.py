@@ -1,0 +1,287 @@
+"""`twin check STATION`, the station doctor, on real physics: it grips what the geometry says it can grip, it
+expects the forces statics gives, and it fails a station that statics or geometry says cannot work, naming the
+finger and the measure. Every expected verdict is computed here from the station's own numbers (sizes, efforts,
+stiffness, friction, mass), never taken from the doctor's output.
+"""
+from __future__ import annotations
+
+import json
+import math
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from tests.conftest import STATIONS
+from twin_app.cli import main
+
+HOLD = "1"  # s: short creep windows keep the tests quick (the thresholds are the same)
+G = 9.81
+
+
+def run_check(station, tmp_path, capsys, *extra):
+    out = tmp_path / "report.json"
+    code = main(["check", str(station), "--hold", HOLD, "--json", str(out), *extra])
+    text = capsys.readouterr().out
+    report = json.loads(out.read_text()) if out.exists() else None
+    return code, text, report
+
+
+def lines(text: str, level: str) -> list[str]:
+    return [ln.strip() for ln in text.splitlines() if ln.strip().startswith(level + " ")]
+
+
+def grip(report: dict, target: str, mode: str) -> dict:
+    return next(g for g in report["grips"] if g["target"] == target and g["mode"] == mode)
+
+
+def consistent_exit(code: int, text: str) -> None:
+    """Exit 1 exactly when a line fails."""
+    assert code == (1 if lines(text, "FAIL") else 0), text
+
+
+# -- a newcomer's 2-finger gripper, written here -------------------------------------------------------------
+FINGER = (0.01, 0.02, 0.05)  # m: thickness (along the closing axis), width, length
+
+
+def two_finger_urdf(path, effort: float) -> None:
+    """Two independent prismatic fingers; each inner face at y = +-q from the centre line (q: 0 to 40 mm)."""
+    t, w, length = FINGER
+
+    def finger(name, sign):
+        return f"""
+  <joint name="{name}_joint" type="prismatic">
+    <parent link="palm"/><child link="{name}"/><origin xyz="0 0 0"/><axis xyz="0 {sign} 0"/>
+    <limit lower="0" upper="0.04" velocity="0.05" effort="{effort}"/>
+  </joint>
+  <link name="{name}">
+    <inertial><origin xyz="0 {sign * t / 2} {length / 2}"/><mass value="0.05"/>
+      <inertia ixx="1.2e-5" ixy="0" ixz="0" iyy="1.1e-5" iyz="0" izz="2.1e-6"/></inertial>
+    <visual><origin xyz="0 {sign * t / 2} {length / 2}"/><geometry><box size="{w} {t} {length}"/></geometry></visual>
+    <collision><origin xyz="0 {sign * t / 2} {length / 2}"/><geometry><box size="{w} {t} {length}"/></geometry></collision>
+  </link>"""
+
+    path.write_text(f"""<?xml version="1.0"?>
+<robot name="newcomer">
+  <link name="palm">
+    <inertial><origin xyz="0 0 -0.01"/><mass value="0.3"/><inertia ixx="2.6e-4" ixy="0" ixz="0" iyy="2.6e-4" iyz="0" izz="5e-4"/></inertial>
+    <visual><origin xyz="0 0 -0.01"/><geometry><box size="0.1 0.1 0.02"/></geometry></visual>
+    <collision><origin xyz="0 0 -0.01"/><geometry><box size="0.1 0.1 0.02"/></geometry></collision>
+  </link>{finger("jaw_a", 1)}{finger("jaw_b", -1)}
+</robot>
+""")
+
+
+BLOCK = (0.03, 0.03, 0.04)  # m: the part, a steel block
+DENSITY = 7850.0
+PART_FRICTION, FINGER_FRICTION = 0.5, 0.8
+
+
+def newcomer_station(folder, effort: float, part_y: float = 0.0, extra: str = "") -> tuple:
+    folder.mkdir()
+    two_finger_urdf(folder / "gripper.urdf", effort)
+    sx, sy, sz = BLOCK
+    # the palm's underside 15 mm above the part: the 50 mm fingers reach 5 mm above the floor
+    (folder / "station.toml").write_text(f"""[station]
+name = "newcomer"
+
+[gripper]
+urdf = "gripper.urdf"
+mount = {{ xyz = [0.0, 0.0, {sz + 0.015}], rpy_deg = [180.0, 0.0, 0.0] }}
+always_active = true
+friction = {FINGER_FRICTION}
+initial = {{ jaw_a = 0.035, jaw_b = 0.035 }}
+{extra}
+
+[[targets]]
+name = "block"
+shape = "box"
+size = [{sx}, {sy}, {sz}]
+xyz = [0.0, {part_y}, {sz / 2}]
+density = {DENSITY}
+friction = {PART_FRICTION}
+
+[[fixtures]]
+name = "floor"
+shape = "plane"
+""")
+    return folder
+
+
+@pytest.mark.parametrize("effort", [0.5, 40.0])
+def test_a_grip_too_weak_for_its_part_fails_on_capacity_naming_its_fingers(tmp_path, capsys, effort):
+    station = newcomer_station(tmp_path / "st", effort)
+    # statics: two fingers pressing with their effort, friction mu on each face, against the block's weight
+    mu = FINGER_FRICTION * PART_FRICTION
+    weight = DENSITY * math.prod(BLOCK) * G
+    holds = mu * 2 * effort >= weight
+    code, text, report = run_check(station, tmp_path, capsys)
+    capacity = [ln for ln in text.splitlines() if " capacity: " in ln]
+    assert len(capacity) == 1, text
+    if holds:
+        assert capacity[0].strip().startswith(("PASS", "WARN")), text
+    else:
+        assert code == 1, text
+        line = capacity[0].strip()
+        assert line.startswith("FAIL") and "jaw_a" in line and "jaw_b" in line, line
+    consistent_exit(code, text)
+    # the weight the doctor judged against is the block's
+    assert grip(report, "block", "outside")["weight"] == pytest.approx(weight, rel=1e-6)
+
+
+def test_a_part_beside_the_fingers_fails_on_reach_for_each_finger(tmp_path, capsys):
+    # geometry: the fingers close along y on x = 0 with a width w; a part whose near side lies beyond w / 2 in x
+    # is never in their way. Put the block's near side 10 mm beyond the fingers' side faces.
+    t, w, length = FINGER
+    station = newcomer_station(tmp_path / "st", 40.0)
+    text = (station / "station.toml").read_text().replace("xyz = [0.0, 0.0, 0.02]",
+                                                           f"xyz = [{w / 2 + BLOCK[0] / 2 + 0.01}, 0.0, 0.02]")
+    (station / "station.toml").write_text(text)
+    code, out, report = run_check(station, tmp_path, capsys)
+    assert code == 1, out
+    failed = lines(out, "FAIL")
+    for finger in ("jaw_a", "jaw_b"):
+        assert any(f" {finger} reach: " in ln and "cannot reach block" in ln for ln in failed), out
+    assert grip(report, "block", "outside")["skipped"]
+
+
+def test_drives_too_soft_to_reach_their_effort_fail_on_force(tmp_path, capsys):
+    # the docs' drive model: a finger stopped on a part presses with K x (setpoint past the part), up to its
+    # effort. The doctor closes to the range's end (q = 0), 15 mm past the block's side (q = 15 mm): with the
+    # effort reached only at 50 mm of error, each finger presses with K x 15 mm = 30 % of its effort.
+    effort, full_error = 40.0, 0.05
+    past = BLOCK[1] / 2 - 0.0
+    share = min(1.0, past / full_error)
+    assert share < 1 - 0.1  # statics says: the force check must fail
+    soft = "".join(f"""[gripper.joints.{jaw}]
+stiffness = {effort / full_error}
+""" for jaw in ("jaw_a", "jaw_b"))
+    station = newcomer_station(tmp_path / "st", effort, extra=soft)
+    code, text, report = run_check(station, tmp_path, capsys)
+    assert code == 1, text
+    for jaw in ("jaw_a", "jaw_b"):
+        assert any(f" {jaw} force: " in ln for ln in lines(text, "FAIL")), text
+        finger = next(f for f in grip(report, "block", "outside")["fingers"] if f["finger"] == jaw)
+        assert finger["force"] == pytest.approx(share * effort, rel=0.2)  # what K x error gives, not the effort
+    consistent_exit(code, text)
+
+
+def test_geometry_and_statics_on_a_mimic_gripper(tmp_path, capsys):
+    """The shipped 2-jaw gripper: one 5 N input, the second jaw mimics it 1:1 (virtual work: 2.5 N a jaw);
+    each jaw's inner face at the joint value from the centre line meets the 20 mm cube at 10 mm."""
+    station = STATIONS / "smart_gripper"
+    root = ET.parse(station / "smart_gripper.urdf").getroot()
+    effort = float(root.find("joint[@name='jaw_left_joint']/limit").get("effort"))
+    code, text, report = run_check(station, tmp_path, capsys)
+    consistent_exit(code, text)
+    g = grip(report, "cube", "outside")
+    assert not g["skipped"]
+    for f in g["fingers"]:
+        assert f["expected_force"] == pytest.approx(effort / 2)
+        assert f["contact_geometry"] == pytest.approx(0.010, abs=0.1e-3)
+        assert f["onset_step"] is not None
+    assert grip(report, "cube", "inside")["skipped"]  # a box has no bore
+    for finger in ("jaw_left", "jaw_right"):
+        for measure in ("status", "noise", "force", "penetration"):
+            assert any(ln.split()[3:5] == [finger, measure + ":"] for ln in text.splitlines()
+                       if ln.strip()[:4] in ("PASS", "WARN", "FAIL")), (finger, measure, text)
+
+
+HINGE, LENGTH, THICK = 0.03, 0.06, 0.01  # m: a hinged finger's pivot from the centre line, its length, thickness
+
+
+def hinged_station(folder, torque: float):
+    """Two revolute fingers hinged at y = +-HINGE on the palm's underside, hanging LENGTH down, their inner
+    faces through the hinge line; closing turns their tips towards the centre line."""
+    folder.mkdir()
+
+    def finger(name, sign):
+        return f"""
+  <joint name="{name}_joint" type="revolute"><parent link="palm"/><child link="{name}"/>
+    <origin xyz="0 {sign * HINGE} 0"/><axis xyz="{sign} 0 0"/><limit lower="0" upper="0.6" velocity="1.0" effort="{torque}"/>
+  </joint>
+  <link name="{name}">
+    <inertial><origin xyz="0 {sign * THICK / 2} {LENGTH / 2}"/><mass value="0.04"/>
+      <inertia ixx="1.2e-5" ixy="0" ixz="0" iyy="1.2e-5" iyz="0" izz="1.7e-6"/></inertial>
+    <collision><origin xyz="0 {sign * THICK / 2} {LENGTH / 2}"/><geometry><box size="0.02 {THICK} {LENGTH}"/></geometry></collision>
+  </link>"""
+
+    (folder / "gripper.urdf").write_text(f"""<?xml version="1.0"?>
+<robot name="hinged">
+  <link name="palm">
+    <inertial><origin xyz="0 0 -0.01"/><mass value="0.3"/><inertia ixx="2.6e-4" ixy="0" ixz="0" iyy="2.6e-4" iyz="0" izz="5e-4"/></inertial>
+    <collision><origin xyz="0 0 -0.01"/><geometry><box size="0.1 0.1 0.02"/></geometry></collision>
+  </link>{finger("hinge_a", 1)}{finger("hinge_b", -1)}
+</robot>
+""")
+    # the hinges 30 mm above the block's top: the finger tips meet its sides, 12 mm above the floor
+    (folder / "station.toml").write_text(f"""[station]
+name = "hinged"
+
+[gripper]
+urdf = "gripper.urdf"
+mount = {{ xyz = [0.0, 0.0, {BLOCK[2] + 0.03}], rpy_deg = [180.0, 0.0, 0.0] }}
+always_active = true
+
+[[targets]]
+name = "block"
+shape = "box"
+size = [{BLOCK[0]}, {BLOCK[1]}, {BLOCK[2]}]
+xyz = [0.0, 0.0, {BLOCK[2] / 2}]
+density = 1000.0
+
+[[fixtures]]
+name = "floor"
+shape = "plane"
+""")
+    return folder
+
+
+def test_revolute_fingers_meet_the_part_where_their_tips_reach_it_and_are_judged_in_torque(tmp_path, capsys):
+    torque = 1.0
+    station = hinged_station(tmp_path / "st", torque)
+    # geometry: a tip turned by a swings LENGTH sin(a) towards the centre line: it meets the block's side there
+    contact = math.asin((HINGE - BLOCK[1] / 2) / LENGTH)
+    code, text, report = run_check(station, tmp_path, capsys)
+    consistent_exit(code, text)
+    g = grip(report, "block", "outside")
+    for f in g["fingers"]:
+        assert f["unit"] == "rad"
+        assert f["contact_geometry"] == pytest.approx(contact, abs=0.002)
+        assert f["expected_force"] == pytest.approx(torque)  # the force of a revolute finger is its torque
+    for finger in ("hinge_a", "hinge_b"):
+        noise = next(ln for ln in text.splitlines() if f" {finger} noise: " in ln)
+        assert "mrad" in noise and "(<= 1.00 mrad)" in noise, noise
+
+
+def test_the_ring_rig_is_gripped_from_outside_and_inside_and_lifted(tmp_path, capsys):
+    """The station's ring: outside contact where a finger's inner face meets the ring's outer radius, inside
+    where its outer face meets the bore (the face offset read from the URDF's collision box); the robot lifts."""
+    station = STATIONS / "ring_rig"
+    root = ET.parse(station / "gripper3.urdf").getroot()
+    col = root.find("link[@name='L2']/collision")
+    face = float(col.find("origin").get("xyz").split()[0]) + float(col.find("geometry/box").get("size").split()[0]) / 2
+    import tomllib
+
+    ring = tomllib.loads((station / "station.toml").read_text())["targets"][0]
+    code, text, report = run_check(station, tmp_path, capsys, "-o", str(tmp_path / "grip.png"))
+    consistent_exit(code, text)
+    outside, inside = grip(report, "ring", "outside"), grip(report, "ring", "inside")
+    for g, contact in ((outside, ring["outer_diameter"] / 2), (inside, ring["inner_diameter"] / 2 - face)):
+        assert not g["skipped"], g["skipped"]
+        assert {f["finger"] for f in g["fingers"]} == {"L2", "L3", "L5"}
+        for f in g["fingers"]:
+            assert f["contact_geometry"] == pytest.approx(contact, abs=0.1e-3), f
+        assert g["lift_slip"] is not None  # the robot lifted it
+    assert {f["drive"] for f in outside["fingers"]} == {"L2", "L3", "L4"}  # finger L5 rides on L4's carriage
+    from PIL import Image
+
+    assert Image.open(tmp_path / "grip.png").size == (960, 360)  # both grips, side by side
+
+
+def test_a_station_that_does_not_load_is_exit_2_naming_the_file_and_key(tmp_path, capsys):
+    station = newcomer_station(tmp_path / "st", 40.0)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace("density = 7850.0", "density = -1.0"))
+    assert main(["check", str(station)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "station.toml" in err[0] and "targets[0].density" in err[0], err
