@@ -163,11 +163,23 @@ class _Reach:
         return best
 
     def closing_drive(self, finger: str) -> str | None:
-        """The servo that moves the finger furthest over its range (a carriage, not the fine axis it carries)."""
+        """The servo that closes the finger: of those that move it, the one that moves it furthest towards or
+        away from the other fingers (a carriage, not the fine axis it carries; not a lift axis that carries every
+        finger alike). A lone finger is measured against the gripper's base."""
         servos = self.g.finger_servos[finger]
         if len(servos) <= 1:
             return servos[0] if servos else None
-        saved, link = self._saved(), self.g.finger_links[finger][0]
+        c, body = self.c, self.body
+
+        def where(f):
+            return c.getLinkState(body, self.g.finger_links[f][0], computeForwardKinematics=True)[4]
+
+        def spread():
+            others = [where(f) for f in self.g.finger_links if f != finger] or [c.getBasePositionAndOrientation(body)[0]]
+            me = where(finger)
+            return sum(math.dist(me, p) for p in others)
+
+        saved = self._saved()
         travel = {}
         try:
             for name in servos:
@@ -175,9 +187,9 @@ class _Reach:
                 ends = []
                 for q in (inp.min, inp.max):
                     self._set(name, q)
-                    ends.append(self.c.getLinkState(self.body, link, computeForwardKinematics=True)[4])
+                    ends.append(spread())
                 self._restore(saved)
-                travel[name] = math.dist(*ends)
+                travel[name] = abs(ends[1] - ends[0])
         finally:
             self._restore(saved)
         return max(servos, key=lambda n: travel[n])
@@ -439,13 +451,16 @@ class Doctor:
                 return
         else:
             missing = [f for f in fingers if plans[f]["outside"] is None]
+            # a ring the fingers can only hold from inside: no outside grip is no failure
+            bore_only = shape == "ring" and all(plans[f]["inside"] is not None for f in fingers)
             if missing:
                 for f in missing:
                     p = plans[f]
                     why = (f"touches it already when fully open (gap {_fmt_len(p['open_gap'])})" if p["open_gap"] <= 0
                            else f"closest {_fmt_len(p['min_gap'])} away over its whole travel")
-                    self.check(FAIL, where, f, "reach", f"cannot reach {name}: {why}")
-                result.skipped = "out of reach"
+                    self.check(INFO if bore_only else FAIL, where, f, "reach", f"cannot reach {name}: {why}"
+                               + (" (it grips the bore)" if bore_only else ""))
+                result.skipped = "the fingers grip it from inside only" if bore_only else "out of reach"
                 return
         drives = sorted({drive_of[f] for f in fingers}, key=list(self.g.joint).index)
         # where each drive starts (free of the part) and where it is told to go (the range's end past the part)

@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 import xml.etree.ElementTree as ET
 
 import pytest
 
 from tests.conftest import STATIONS
+from tests.grippers import station
 from twin_app.cli import main
 
 HOLD = "1"  # s: short creep windows keep the tests quick (the thresholds are the same)
@@ -260,8 +262,6 @@ def test_the_ring_rig_is_gripped_from_outside_and_inside_and_lifted(tmp_path, ca
     root = ET.parse(station / "gripper3.urdf").getroot()
     col = root.find("link[@name='L2']/collision")
     face = float(col.find("origin").get("xyz").split()[0]) + float(col.find("geometry/box").get("size").split()[0]) / 2
-    import tomllib
-
     ring = tomllib.loads((station / "station.toml").read_text())["targets"][0]
     code, text, report = run_check(station, tmp_path, capsys, "-o", str(tmp_path / "grip.png"))
     consistent_exit(code, text)
@@ -285,3 +285,30 @@ def test_a_station_that_does_not_load_is_exit_2_naming_the_file_and_key(tmp_path
     assert main(["check", str(station)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "station.toml" in err[0] and "targets[0].density" in err[0], err
+
+
+def test_a_lift_axis_carrying_both_fingers_is_not_taken_for_their_closing_drive(tmp_path, capsys):
+    """A gantry gripper (tests/grippers/light_5n): a vertical lift carries two 5 N jaws. The lift moves the jaws
+    further than the jaws themselves do, but never towards each other: the jaws close on the 20 mm cube where
+    their inner faces (at the joint value from the centre line) meet its sides, 10 mm out."""
+    folder = station("light_5n")
+    cube = tomllib.loads((folder / "station.toml").read_text())["targets"][0]
+    code, text, report = run_check(folder, tmp_path, capsys)
+    consistent_exit(code, text)
+    g = grip(report, "cube", "outside")
+    assert not g["skipped"], g["skipped"]
+    for f in g["fingers"]:
+        assert f["drive"] == f["finger"]
+        assert f["contact_geometry"] == pytest.approx(cube["size"][1] / 2, abs=0.1e-3)
+
+
+def test_a_ring_the_fingers_can_hold_only_from_inside_is_no_reach_failure(tmp_path, capsys):
+    """A revolute chuck inside a ring's bore (tests/grippers/revolute_chuck_bore): its levers, fully open, stand
+    in the ring's wall, so there is no outside grip; that is said, not failed, and the bore is gripped."""
+    code, text, report = run_check(station("revolute_chuck_bore"), tmp_path, capsys)
+    consistent_exit(code, text)
+    assert grip(report, "ring", "outside")["skipped"]
+    assert not any(" reach: " in ln for ln in lines(text, "FAIL")), text
+    assert any(" reach: " in ln for ln in lines(text, "INFO")), text
+    inside = grip(report, "ring", "inside")
+    assert not inside["skipped"] and all(f["onset_step"] is not None for f in inside["fingers"])
