@@ -45,18 +45,10 @@ def realtime_run(seconds: float, view: bool, browser, record: bool | None = None
         with twin_server(STATION, lockstep=False, extra_args=extra) as server:
             page = None
             fps = None
-            if view:
-                import re
-
-                for _ in range(600):
-                    m = re.search(r"view on (http://\S+)", server.log.read_text(errors="replace"))
-                    if m:
-                        break
-                    time.sleep(0.1)
-                time.sleep(2.0)  # the page process has started
+            url = server.endpoint("view")["url"] if view else None  # the page is up when the server is ready
             if view and browser is not None:
                 page = browser.new_page(viewport={"width": 1024, "height": 700})
-                page.goto(m.group(1))
+                page.goto(url)
                 page.wait_for_selector("#sim-state", timeout=120000)
                 page.wait_for_timeout(2000)
             with server.client() as plc:

@@ -19,26 +19,26 @@ As pytest fixtures (in your `conftest.py`: `pytest_plugins = ["plc_client.testin
         twin_client.advance(100)
         assert twin_client.get("axis1.actual") == pytest.approx(320.0, abs=0.5)
 
-`plc_server` gives the running server (`.host`, `.port`, `.map`, `.client()`), `plc_lockstep` (default
-True) chooses lockstep or real time. See docs/commissioning-checks.md.
+`plc_server` gives the running server (`.host`, `.port`, `.map`, `.client()`, `.events`: what the server
+says happened, `twin serve --events`, docs/events.md), `plc_lockstep` (default True) chooses lockstep or
+real time. See docs/commissioning-checks.md.
 """
 from __future__ import annotations
 
 import contextlib
 import json
 import os
-import re
 import socket
 import subprocess
 import sys
 import tempfile
-import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 from .client import ClientIO, RegisterMap, TwinClient
 from .errors import PlcClientError
+from .events import EventLog
 
 LOOPBACK = "127.0.0.1"
 
@@ -83,6 +83,12 @@ class TwinServer:
         return path
 
     map_json: str = ""
+    events: "EventLog | None" = None  # `twin serve --events`: what happened (docs/events.md)
+    log: Path | None = None  # the server's log (stderr): for people, not parsed
+
+    def endpoint(self, name: str = "modbus", protocol: str | None = None) -> dict:
+        """A front end's address as the `ready` event gives it (`name`: modbus, opcua, view)."""
+        return self.events.endpoint(name, protocol)
 
     @property
     def running(self) -> bool:
@@ -116,40 +122,30 @@ def twin_server(station: str | Path, *, lockstep: bool = True, speed: float | No
     mode = ["--lockstep"] if lockstep else ["--realtime", *(["--speed", f"{speed:g}"] if speed else [])]
     with tempfile.NamedTemporaryFile(mode="w+", prefix="twin-serve-", suffix=".log", delete=False) as log:
         log_path = Path(log.name)
+        events_path = log_path.with_suffix(".events.jsonl")
         proc = subprocess.Popen([*twin_command(), "serve", str(station), "--host", host, "--port", str(port),
-                                 "--unit-id", str(unit_id), *mode,
+                                 "--unit-id", str(unit_id), *mode, "--events", str(events_path),
                                  *(["--faults", str(faults)] if faults else []), *extra_args],
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log)
     server = None
     try:
-        bound = _wait_listening(proc, log_path, startup_timeout)
-        if bound is None:
+        events = EventLog(events_path, proc)
+        ready = events.wait("ready", startup_timeout)
+        if ready is None:
             _stop(proc)
             text = log_path.read_text(errors="replace").strip()
             raise ServerStartError(f"`twin serve {station}` did not start: {text[-2000:] or 'no output'}")
-        server = TwinServer(station, host, bound, unit_id, lockstep, rmap, proc, map_json=json.dumps(rmap.as_list()))
-        server.log = log_path
+        modbus = events.endpoint("modbus")
+        server = TwinServer(station, modbus["host"], modbus["port"], unit_id, lockstep, rmap, proc,
+                            map_json=json.dumps(rmap.as_list()), events=events, log=log_path)
         yield server
     finally:
         _stop(proc)
         log_path.unlink(missing_ok=True)
+        events_path.unlink(missing_ok=True)
         mf = getattr(server, "_map_file", None)
         if mf is not None:
             mf.unlink(missing_ok=True)
-
-
-def _wait_listening(proc: subprocess.Popen, log: Path, timeout: float) -> int | None:
-    """The port from the server's "listening on HOST:PORT" line, or None if it exits or takes too long."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        for line in log.read_text(errors="replace").splitlines():
-            m = re.search(r"listening on \S+:(\d+)", line)
-            if m:
-                return int(m.group(1))
-        if proc.poll() is not None:
-            return None
-        time.sleep(0.02)
-    return None
 
 
 def _stop(proc: subprocess.Popen) -> None:

@@ -79,6 +79,7 @@ class Exchange:
         self.constants = dict(constants or {})
         self.runner = None  # mode ("realtime"/"lockstep"), speed, late_steps, last_late, remaining, request(n)
         self.fault = False
+        self.on_fault: Callable[[str], None] | None = None  # told the fault's one-line message (the event stream)
         self._in_step = False
         self.pending: list[Sequence[Write]] = []  # accepted batches, not yet applied
         self._written: dict[str, object] = {}
@@ -171,6 +172,8 @@ class Exchange:
             self.fault = True
             self.log(f"simulation fault at step {self.twin.step_count}: {type(exc).__name__}: {exc}; gave up\n"
                      + traceback.format_exc().rstrip())
+            if self.on_fault is not None:
+                self.on_fault(f"{type(exc).__name__}: {exc}")
             self.publish()
             return False
         if not publish:

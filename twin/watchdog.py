@@ -51,6 +51,7 @@ class Watchdog:
         self.open_setpoints = dict(open_setpoints or {})
         self.log = log or (lambda text: logging.getLogger("twin.serve").warning(text))
         self.signals = watchdog_signals(safe_state)  # declared in the static signal table
+        self.on_event: Callable[..., None] | None = None  # `twin.events.Events.emit`: lost and restored
         self.clock: Callable[[], float] | None = None  # None: the twin's simulated time
         self.twin = None
         self.last_seen: dict[str, float] = {}  # source -> when its last request came
@@ -93,6 +94,8 @@ class Watchdog:
             self.lost = False
             self.log(f"comm restored: request from {source} after {t - self.last:.3f} s of silence; "
                      f"{COMM_LOST} cleared")
+            if self.on_event is not None:
+                self.on_event("comm_restored", source=source, silent_s=round(t - self.last, 6))
         self.last, self.last_source = t, source
 
     # -- the Device protocol --------------------------------------------------------------------------
@@ -114,6 +117,9 @@ class Watchdog:
             self.trips += 1
             self.log(f"comm lost: no request for {silent:.3f} s (watchdog {self.timeout:g} s; last from "
                      f"{self.last_source}); {COMM_LOST} raised, gripper to its safe state '{self.safe_state}'")
+            if self.on_event is not None:
+                self.on_event("comm_lost", silent_s=round(silent, 6), timeout_s=self.timeout,
+                              last_source=self.last_source, safe_state=self.safe_state)
             self._safe_state(twin)
 
     def _safe_state(self, twin) -> None:

@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import os
 import signal as _signal
 from collections.abc import Callable
 from pathlib import Path
@@ -60,6 +61,7 @@ from twin.core.errors import StationError, TwinError
 from twin.core.signal_table import SIM_MAP_CRC, SIM_NAMES, WATCHDOG_MS, station_signals
 from twin.core.station import Station, load_station
 from twin.core.twin import Twin
+from twin.events import CONTROLLER, FAULT, READY, STOPPED, Events
 from twin.exchange import Exchange
 from twin.modbus.log import announce as _announce, log as _log
 from twin.modbus.register_map import RegisterMap, build_register_map
@@ -94,7 +96,7 @@ class Cell:
 
     def __init__(self, station: str | Path | Station, on_event: Callable[[dict], None] | None = None, *,
                  entry: str | None = None, log: Callable[..., None] = _log, announce: Callable[[str], None] = _announce,
-                 publish: bool = True):
+                 publish: bool = True, events: Events | None = None):
         """Load a station (a folder, a station.toml, or a `Station`, e.g. one with a campaign's parameters
         applied); if it has a `[controller]`, its RAPID program runs as the robot controller.
 
@@ -102,20 +104,27 @@ class Cell:
         runtime error; see `rapid_like.controller`); `entry` overrides the station's entry routine.
         A program that does not parse or check raises a `rapid_like` error naming file:line:column.
         `publish=False`: in-process steps take no snapshot (see the module docstring).
+        `events`: the machine interface (`twin.events`, `twin serve --events`): the cell, its controller,
+        its watchdog and its front ends write what happens there.
         """
         self.publishing = publish
+        self.events = events if events is not None else Events()
         self.station = station if isinstance(station, Station) else load_station(station)
         self.signals = station_signals(self.station)
         self.register_map: RegisterMap = build_register_map(self.signals, self.station.name)
         self.log, self.announce = log, announce  # log(text, level); announce: shown at every log level
         self.twin = Twin(self.station)
+        twin = self.twin
+        self.events.clock = lambda: (twin.step_count, twin.time)
         self.controller = None
         try:
             self.watchdog = self._add_watchdog()  # before the controller, so a DI may read comm.lost
+            self.watchdog.on_event = self.events.emit
             if self.station.controller is not None:
-                self.controller = attach_controller(self.twin, on_event=on_event, entry=entry)
+                self.controller = attach_controller(self.twin, on_event=self._controller_event(on_event), entry=entry)
             self.exchange = Exchange(self.twin, log=log, constants={
                 SIM_MAP_CRC: self.register_map.crc, WATCHDOG_MS: round((self.watchdog.timeout or 0) * 1000)})
+            self.exchange.on_fault = lambda message: self.events.emit(FAULT, message=message)
             if self.exchange.signals != self.signals:
                 raise TwinError(f"station {self.station.name!r}: the running cell's signal table differs from the "
                                 "static one (twin.core.signal_table)")
@@ -124,6 +133,20 @@ class Cell:
             raise
         self.front_ends: list[FrontEnd] = []
         self.runner = None
+
+    def _controller_event(self, on_event: Callable[[dict], None] | None) -> Callable[[dict], None] | None:
+        """The controller's events go to `on_event` and, stamped with their own simulated time, to `events`."""
+        events = self.events
+        if not events.enabled:
+            return on_event
+
+        def both(event: dict) -> None:
+            if on_event is not None:
+                on_event(event)
+            fields = dict(event)
+            t = fields.pop("t", None)
+            events.emit(CONTROLLER, t=t, **fields)
+        return both
 
     def _add_watchdog(self) -> Watchdog:
         return add_watchdog(self.twin)
@@ -204,11 +227,14 @@ class Cell:
                     lines = await front.start(self)
                 except (OSError, TwinError) as exc:
                     self.log(f"error: {exc}", logging.ERROR)
+                    self.events.emit(STOPPED, steps=self.twin.step_count, requests=0, error=str(exc))
                     return 2
                 started.append(front)
                 for line in [lines] if isinstance(lines, str) else lines:
                     self.announce(line)
             self.exchange.publish()  # what the front ends changed (e.g. the watchdog's time)
+            self.events.emit(READY, pid=os.getpid(), station=self.station.name, lockstep=lockstep,
+                             front_ends=[e for f in started for e in getattr(f, "endpoints", lambda: [])()])
             task = asyncio.ensure_future(runner.run())
             stopper = asyncio.ensure_future(stop.wait())
             await asyncio.wait({task, stopper}, return_when=asyncio.FIRST_COMPLETED)
@@ -226,6 +252,8 @@ class Cell:
                 await front.close()
         late = f", {runner.late_steps} late" if not lockstep else ""
         requests = sum(getattr(f, "requests", 0) for f in started)
+        self.events.emit(STOPPED, steps=self.twin.step_count, requests=requests,
+                         **({} if lockstep else {"late_steps": runner.late_steps}))
         self.announce(f"stopped after {self.twin.step_count} steps ({self.twin.time:.3f} s simulated{late}, "
                       f"{requests} requests)")
         return 0

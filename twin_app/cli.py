@@ -9,7 +9,8 @@
 
 `serve` assembles the cell (`twin_app.cell.Cell`) and plugs its front ends in (Modbus/TCP:
 `twin.modbus.front_end`). It logs to stderr through `twin.modbus.log`: a line when it starts loading the
-station, one when listening (with the bound port, so `--port 0` is usable), one when stopped; it stops
+station, one when listening, one when stopped (a program reads `--events FILE|-` instead: JSON lines with
+the bound ports, clients, the robot's words, stopped; docs/events.md); it stops
 cleanly on Ctrl-C or SIGTERM (exit 0); one that comes while the station is loading stops it once loaded.
 
 User errors (a wrong station file, an unknown URDF, a bad signal) print one line on stderr and exit
@@ -164,11 +165,12 @@ class _StartUpSignals:
             signal.signal(sig, handler)
 
 
-def open_served_cell(station):
-    """A station's cell as the servers run it, its robot controller's words in the log."""
+def open_served_cell(station, events=None):
+    """A station's cell as the servers run it, its robot controller's words in the log (and, with `events`,
+    in the machine interface: `twin.events`)."""
     from .cell import Cell
 
-    return Cell(Path(station), on_event=controller_log)
+    return Cell(Path(station), on_event=controller_log, events=events)
 
 
 def cmd_serve(args) -> int:
@@ -181,6 +183,13 @@ def cmd_serve(args) -> int:
 
     if (problem := check_opcua_arguments(args)) is not None:
         print(f"twin serve: error: {problem}", file=sys.stderr)
+        return 2
+    from twin.events import Events
+
+    try:
+        events = Events.open(args.events)
+    except OSError as exc:
+        print(f"twin serve: error: --events {args.events}: {exc.strerror or exc}", file=sys.stderr)
         return 2
     stop = asyncio.Event()
     signals = _StartUpSignals(stop)  # first thing: loading the station (pybullet) takes a while
@@ -195,7 +204,7 @@ def cmd_serve(args) -> int:
         announce(f"loading station {args.station}")
         from twin.modbus.front_end import ModbusFrontEnd
 
-        cell = open_served_cell(args.station)
+        cell = open_served_cell(args.station, events)
         if getattr(args, "faults", None):
             from twin.faults import FaultInjector
 
@@ -225,6 +234,7 @@ def cmd_serve(args) -> int:
         if signals.received is None:
             raise
         announce(f"stopped by {signal.Signals(signals.received).name} while starting")
+        events.emit("stopped", steps=0, requests=0, error=f"stopped by {signal.Signals(signals.received).name} while starting")
         return 0
     finally:
         signals.ignore()
@@ -233,6 +243,7 @@ def cmd_serve(args) -> int:
                 cell.close()
         finally:
             signals.restore()
+            events.close()
             serve_log.flush()
 
 
@@ -270,6 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
     from twin.opcua.serve import add_arguments as add_opcua_arguments  # --opcua [PORT], --no-modbus, --opcua-*
 
     add_opcua_arguments(serve)
+    serve.add_argument("--events", metavar="FILE|-", default=None,
+                       help="write what happens (ready with each front end's address, clients, comm lost, the robot "
+                            "controller's events, fault, stopped) as JSON lines to FILE or stdout: docs/events.md")
     add_view_commands(sub, open_served_cell)
     return parser
 

@@ -12,7 +12,7 @@ drives the finger setpoints over the network and confirms a grip only when every
 passed the threshold; fingers that reach the end of travel without it are a missed grip, reported to
 the robot, which tries once more and then stops the cycle.
 
-It prints each step as it happens, the robot's TPWrite lines (relayed from the server's log) and the
+It prints each step as it happens, the robot's TPWrite lines (from the server's events, docs/events.md) and the
 PLC's view, both stamped with simulated time, then a summary: cycles, grips, misses, cycle time in
 simulated and in wall seconds, and how far the ring ends from where it started. `--remove-ring K`
 takes the ring out of the cell (coil `ring.present`) when cycle K starts: the miss is detected and
@@ -33,8 +33,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
-import socket
 import sys
 import time
 from dataclasses import dataclass, field
@@ -150,7 +148,7 @@ class CellDemo:
         self.faults = None if faults is None else Path(faults)  # twin serve --faults FILE: plant faults
 
     def say(self, who: str, text: str, t: float | None = None) -> None:
-        """A narration line stamped with simulated time: `t` (the robot's own, from the server's log), else now."""
+        """A narration line stamped with simulated time: `t` (the robot's own, from the server's events), else now."""
         self.out(f"[t={self.now if t is None else t:8.3f} s] {who}: {text}")
 
     def run(self) -> Summary:
@@ -191,7 +189,7 @@ class CellDemo:
         plc = ScanCycle(ClientIO(client, lockstep=not self.realtime), logic, cycle=self.scan_cycle,
                         inputs=tuple(dict.fromkeys((*logic.inputs, *WATCH))), speed=self.speed if self.realtime else 1.0)
         grip_state = plc.state[0]
-        log = _LogTail(server.log)
+        events = server.events  # written as they happen: a scan's answer comes after its steps' events
         s = Summary(self.cycles, remove_ring_at=self.remove_ring_at, faults=None if self.faults is None else str(self.faults))
         cpu0 = (time.process_time(), _process_cpu(server.process.pid))
         wall0 = time.perf_counter()
@@ -201,7 +199,7 @@ class CellDemo:
         while True:
             image = plc.scan()
             self.now = image["sim.time_ms"] / 1000.0
-            for t, line in log.lines():
+            for t, line in robot_lines(events.new()):
                 self.say("robot", line, t)
             phase = grip_state.phase
             if phase != seen["phase"]:
@@ -238,7 +236,7 @@ class CellDemo:
             if self.now > limit:
                 self.say("demo", f"gave up: the cycles did not end within {limit:g} s of simulated time")
                 break
-        for t, line in log.lines_until_now(server.host, server.port):
+        for t, line in robot_lines(events.new()):
             self.say("robot", line, t)
         self.scans, self.requests = plc.scans, client.requests
         self.cpu = (time.process_time() - cpu0[0], _process_cpu(server.process.pid) - cpu0[1])  # PLC, twin serve
@@ -347,53 +345,20 @@ def injected_fault_text(s: Summary) -> str:
         ", though the robot stopped the cycle" if s.stopped else ", and the robot did not stop the cycle")
 
 
-class _LogTail:
-    """New lines of the server's log that the robot program wrote (its TPWrite and errors)."""
-
-    def __init__(self, path: Path):
-        self.path, self.offset, self.rest = path, 0, ""
-
-    def lines(self) -> list[tuple[float | None, str]]:
-        """(simulated time the server stamped, text) of each new robot line."""
-        return [robot for line in self._new_lines() if (robot := _robot_line(line))]
-
-    def lines_until_now(self, host: str, port: int, timeout: float = 10.0) -> list[tuple[float | None, str]]:
-        """Every robot line the server logged up to now, including those its log thread has not written yet.
-
-        The server's log is one queue written in order: a connection opened now is logged after every line
-        of the steps already run, so once that line is in the file, so is everything before it."""
-        with socket.create_connection((host, port), timeout=timeout) as probe:
-            own_host, own_port = probe.getsockname()[:2]
-        marker = f"client {own_host}:{own_port} connected"
-        found, deadline = [], time.monotonic() + timeout
-        while True:
-            for line in self._new_lines():
-                if marker in line:
-                    return found
-                if robot := _robot_line(line):
-                    found.append(robot)
-            if time.monotonic() > deadline:  # a server logging below info: what is there is all we get
-                return found
-            time.sleep(0.01)
-
-    def _new_lines(self) -> list[str]:
-        with open(self.path, "r", encoding="utf-8", errors="replace") as f:
-            f.seek(self.offset)
-            text = f.read()
-            self.offset = f.tell()
-        text, self.rest = self.rest + text, ""
-        if text and not text.endswith("\n"):
-            text, _, self.rest = text.rpartition("\n")
-        return text.splitlines()
-
-
-def _robot_line(line: str) -> tuple[float | None, str] | None:
-    """"twin serve: [t=2.064 s] robot: Gripped ..." -> (2.064, "Gripped ..."); None for other lines."""
-    head, sep, tail = line.partition("] robot")
-    if not sep:
-        return None
-    stamp = re.search(r"\[t=\s*([0-9.]+) s$", head)
-    return float(stamp.group(1)) if stamp else None, tail.lstrip(": ").strip()
+def robot_lines(events: list[dict]) -> list[tuple[float, str]]:
+    """(simulated time, text) of what the robot controller said, from the server's events (docs/events.md):
+    its TPWrite lines, a runtime error, the end of its program."""
+    lines = []
+    for e in events:
+        if e["event"] != "controller":
+            continue
+        if e["type"] == "print":
+            lines.append((e["t"], e["text"]))
+        elif e["type"] == "error":
+            lines.append((e["t"], f"program error at line {e['line']}: {e['message']}"))
+        elif e["type"] == "end":
+            lines.append((e["t"], f"program ended ({e['reason']})"))
+    return lines
 
 
 def main(args) -> int:

@@ -9,9 +9,12 @@ import socket
 import struct
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
+
+from plc_client.events import EventLog
 
 ROOT = Path(__file__).resolve().parents[2]
 RING_BENCH = ROOT / "tests" / "plc" / "stations" / "ring_bench"  # the ring rig's gripper, no robot
@@ -19,38 +22,50 @@ SMART_GRIPPER = ROOT / "stations" / "smart_gripper"
 
 
 class ServerProcess:
-    """`twin serve STATION --port 0 ...` as a subprocess; its stderr is collected line by line."""
+    """`twin serve STATION --port 0 ... --events FILE` as a subprocess: where it listens comes from its `ready`
+    event (docs/events.md), what happens next from `events`; its stderr (the log) is collected in `lines`."""
 
     def __init__(self, station: Path, *args: str, drain: bool = True, port: str = "0"):
-        """`drain=False`: stderr is read up to the `listening on` line(s), then nobody reads the pipe."""
+        """`drain=False`: stderr is read until the server is ready, then nobody reads the pipe."""
         self._start([sys.executable, "-m", "twin", "serve", str(station), "--port", port, *args], drain=drain)
         self.tls_port = None
         if "--tls-cert" in self.cmd:
-            self.tls_port = int(self.wait_for(r"listening on [\d.]+:(\d+) \(Modbus/TCP Security", timeout=30).group(1))
+            self.tls_port = self.endpoint("modbus", "modbus/tcp+tls")["port"]
         self.host, self.port = "127.0.0.1", self.tls_port
         if "--tls-only" not in self.cmd:
-            m = self.wait_for(r"listening on ([\d.]+):(\d+)$", timeout=30)
-            self.host, self.port = m.group(1), int(m.group(2))
+            front = self.endpoint("modbus", "modbus/tcp")
+            self.host, self.port = front["host"], front["port"]
 
-    def _start(self, cmd: list[str], drain: bool = True, env: dict[str, str] | None = None) -> None:
-        """Start `cmd` (a `twin serve` command line) and collect its stderr in `lines` from a thread."""
+    def _start(self, cmd: list[str], drain: bool = True, env: dict[str, str] | None = None,
+               timeout: float = 30.0) -> None:
+        """Start `cmd` (a `twin serve` command line) with `--events FILE`, collect its stderr in `lines` from a
+        thread, and wait for its `ready` event (AssertionError, with the log, if it does not come)."""
+        self._dir = tempfile.TemporaryDirectory(prefix="twin-serve-")
+        cmd = [*cmd, "--events", str(Path(self._dir.name) / "events.jsonl")]
         self.cmd, self.drain = cmd, drain
         self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                      cwd=ROOT, env={**os.environ, "PYTHONUNBUFFERED": "1", **(env or {})})
+        self.events = EventLog(Path(self._dir.name) / "events.jsonl", self.proc)
         self.lines: list[str] = []
         self._seen = threading.Condition()
+        self._ready = threading.Event()
         threading.Thread(target=self._drain, daemon=True).start()
+        self.ready = self.events.wait("ready", timeout)
+        self._ready.set()
+        if self.ready is None:
+            self.stop()
+            raise AssertionError("`twin serve` did not get ready; its log:\n" + "\n".join(self.lines))
+
+    def endpoint(self, name: str, protocol: str | None = None) -> dict:
+        """A front end's address from the `ready` event."""
+        return self.events.endpoint(name, protocol)
 
     def _drain(self) -> None:
-        drain = self.drain
-        listening = 0
-        want = 2 if "--tls-cert" in self.cmd and "--tls-only" not in self.cmd else 1
         for line in self.proc.stderr:
             with self._seen:
                 self.lines.append(line.rstrip("\n"))
                 self._seen.notify_all()
-            listening += "listening on" in line
-            if not drain and listening >= want:
+            if not self.drain and self._ready.is_set():
                 return  # from now on nobody reads the pipe
         with self._seen:
             self._seen.notify_all()
@@ -79,6 +94,7 @@ class ServerProcess:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        self.events.new()  # the last ones (`stopped`)
         return self.proc.returncode
 
     def __enter__(self) -> "ServerProcess":

@@ -1,7 +1,6 @@
 """A `twin serve STATION --opcua 0` subprocess, and asyncua client helpers."""
 from __future__ import annotations
 
-import re
 import sys
 from pathlib import Path
 
@@ -23,10 +22,10 @@ class OpcUaServerProcess(ServerProcess):
         extra = ["--opcua-cert-dir", str(cert_dir)] if cert_dir is not None else []
         env = {"XDG_DATA_HOME": str(ROOT / ".pytest_cache" / "opcua-certs")} if cert_dir is None else {}
         self._start([sys.executable, "-m", "twin", "serve", str(station), "--port", "0", "--opcua", "0", *extra, *args],
-                    env=env)
-        self.url = self.wait_for(r"OPC UA listening on (\S+)", timeout=90).group(1)
-        m = re.search(r"listening on ([\d.]+):(\d+)$", "\n".join(self.lines), re.M)
-        self.host, self.port = (m.group(1), int(m.group(2))) if m else ("127.0.0.1", None)
+                    env=env, timeout=90)
+        self.url = self.endpoint("opcua")["url"]
+        modbus = [f for f in self.ready["front_ends"] if f["name"] == "modbus"]
+        self.host, self.port = (modbus[0]["host"], modbus[0]["port"]) if modbus else ("127.0.0.1", None)
 
 
 async def namespace(client: Client, station: str = "ring_rig") -> int:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import io
 import os
-import re
 import shutil
 import time
 from pathlib import Path
@@ -41,17 +40,6 @@ def browser():
             yield b
         finally:
             b.close()
-
-
-def view_url(log: Path, timeout: float = 60.0) -> str:
-    """The page's address from a server's log ("view on http://HOST:PORT")."""
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        m = re.search(r"view on (http://\S+)", log.read_text(errors="replace"))
-        if m:
-            return m.group(1)
-        time.sleep(0.1)
-    raise AssertionError(f"no 'view on' line in the server's log: {log.read_text(errors='replace')[-2000:]}")
 
 
 def image_stats(png: bytes):

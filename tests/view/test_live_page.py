@@ -10,7 +10,7 @@ import pytest
 
 from plc_client.testing import twin_server
 from tests.conftest import STATIONS
-from tests.view.conftest import image_stats, signal_cell, view_url, wait_for_cell
+from tests.view.conftest import image_stats, signal_cell, wait_for_cell
 from twin.core import SignalRangeError, Twin
 
 STATION = STATIONS / "ring_rig_plc"
@@ -20,7 +20,7 @@ STATION = STATIONS / "ring_rig_plc"
 def served():
     pytest.importorskip("viser")
     with twin_server(STATION, lockstep=True, extra_args=["--view", "0"]) as server:
-        yield server, view_url(server.log)
+        yield server, server.endpoint("view")["url"]
 
 
 @pytest.fixture

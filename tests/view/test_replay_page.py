@@ -4,13 +4,12 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
-import tempfile
-from pathlib import Path
 
 import pytest
 
+from plc_client.events import EventLog
 from tests.conftest import ROOT, STATIONS
-from tests.view.conftest import signal_cell, view_url, wait_for_cell
+from tests.view.conftest import signal_cell, wait_for_cell
 from twin.core import Twin
 from twin.recording import record
 
@@ -24,16 +23,16 @@ def replay(tmp_path_factory):
         twin.step(5)
         twin.write("jaw_left", twin.spec("jaw_left").min)
         twin.step(70)
-    log = Path(tempfile.mkstemp(prefix="twin-replay-", suffix=".log")[1])
-    with open(log, "w") as err:
-        proc = subprocess.Popen([sys.executable, "-m", "twin", "view", "--replay", str(path), "--port", "0"], cwd=ROOT,
-                                stdout=subprocess.DEVNULL, stderr=err)
+    events = path.with_suffix(".events.jsonl")
+    proc = subprocess.Popen([sys.executable, "-m", "twin", "view", "--replay", str(path), "--port", "0",
+                             "--events", str(events)], cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        yield view_url(log)
+        stream = EventLog(events, proc)
+        assert stream.wait("ready", 60) is not None, "`twin view --replay` did not get ready"
+        yield stream.endpoint("view")["url"]
     finally:
         proc.terminate()
         proc.wait(timeout=10)
-        log.unlink(missing_ok=True)
 
 
 def step_shown(page) -> int:

@@ -93,6 +93,7 @@ class ModbusFrontEnd:
             max_connections=self.max_connections, idle_timeout=self.idle_timeout or None, allow=self.allow,
             read_only=self.read_only, gaps_zero=self.gaps == "zero", identity=device_identity(cell.station, rmap),
             on_request=on_request, log=self.log, behind=(lambda: runner.last_late) if not lockstep and runner else None)
+        server.on_event = getattr(getattr(cell, "events", None), "emit", None)
         lines = []
         if self.profile is not None:
             from .profile import MAP_UNIT_ID, serve_profile
@@ -122,6 +123,11 @@ class ModbusFrontEnd:
             lines.append(f"profile {self.profile.kind} on {where}")
         lines += [f"listening on {host}:{bound}{what}" for what, host, bound in self.listening]
         return lines
+
+    def endpoints(self) -> list[dict]:
+        """Where it listens, for the `ready` event (`twin.events`)."""
+        return [{"name": self.name, "protocol": "modbus/tcp+tls" if what else "modbus/tcp", "host": host, "port": port}
+                for what, host, port in self.listening]
 
     @property
     def requests(self) -> int:

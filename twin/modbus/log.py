@@ -7,8 +7,8 @@ the queue fills, and further records are dropped and counted: the serving thread
 sink drains, the writer says how many lines were lost (`N log lines dropped: the log sink was full`).
 
 `log(text)` is the old call (INFO on the `twin.serve` logger). Start-up and shutdown lines (`loading`,
-`listening on`, `stopped`) go to `lifecycle`, which `--log-level` does not silence, so a harness can always
-find the bound port. Imports nothing heavy, so `twin serve` can log before it loads a station.
+`listening on`, `stopped`) go to `lifecycle`, which `--log-level` does not silence. The log is for people: a
+program reads `twin serve --events` (`twin.events`, docs/events.md), never these lines. Imports nothing heavy, so `twin serve` can log before it loads a station.
 """
 from __future__ import annotations
 

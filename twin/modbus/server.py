@@ -143,6 +143,7 @@ class ModbusServer:
         self.behind = behind  # the simulation is late: answer less until it has caught up
         self.scale = 1.0  # the share of the budget in force (halved per late period, regrown when on time)
         self.log, self.clock = log, clock
+        self.on_event: Callable[..., None] | None = None  # `twin.events.Events.emit`: clients come and go
         self.connections: set[_Connection] = set()
         self._servers: list[asyncio.base_events.Server] = []
         self.refused = 0  # connections refused (allow list, limit)
@@ -344,16 +345,21 @@ class _Connection(asyncio.Protocol):
             server.refused += 1
             self.closed = True
             server.log(f"client {self.peer} refused: {why}")
+            if server.on_event is not None:
+                server.on_event("client_refused", front_end="modbus", peer=self.peer, reason=why)
             transport.abort()
             return
         self.admitted = True
         server.connections.add(self)
-        extra = ""
+        extra, tls = "", {}
         if self.tls:
             cert = transport.get_extra_info("peercert") or {}
             subject = dict(x[0] for x in cert.get("subject", ()) if x)
             extra = f" over TLS as {subject.get('commonName', '?')!r}"
+            tls = {"tls_subject": subject.get("commonName", "")}
         server.log(f"client {self.peer} connected{extra} ({len(server.connections)} connected)")
+        if server.on_event is not None:
+            server.on_event("client_connected", front_end="modbus", peer=self.peer, connected=len(server.connections), **tls)
 
     def connection_lost(self, exc) -> None:
         self.closed = True
@@ -363,6 +369,9 @@ class _Connection(asyncio.Protocol):
         self.server.connections.discard(self)
         reason = self.reason or (f"error: {exc}" if exc else "closed by the client")
         self.server.log(f"client {self.peer} disconnected ({reason}; {len(self.server.connections)} connected)")
+        if self.server.on_event is not None:
+            self.server.on_event("client_gone", front_end="modbus", peer=self.peer, reason=reason,
+                                 connected=len(self.server.connections))
 
     def close(self, reason: str) -> None:
         """Drop the connection now (anything not yet sent is lost)."""

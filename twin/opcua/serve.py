@@ -177,6 +177,15 @@ class OpcUaFrontEnd:
         return [f"OPC UA: namespace {self.server.space.namespace_uri} (ns={self.server.ns}), {len(self.server.space)} "
                 f"variables, security {policies}{users}{fed}", f"OPC UA listening on {self.server.endpoint}"]
 
+    def endpoints(self) -> list[dict]:
+        """Where it listens, for the `ready` event (`twin.events`)."""
+        if self.server is None:
+            return []
+        from urllib.parse import urlsplit
+
+        url = urlsplit(self.server.endpoint)
+        return [{"name": self.name, "protocol": "opc.tcp", "host": self.host, "port": url.port, "url": self.server.endpoint}]
+
     async def close(self) -> None:
         if self.link is not None:
             self.link.detach()

@@ -39,6 +39,8 @@ def add_commands(sub, open_cell) -> None:
     p.add_argument("--record", metavar="FILE", default=None, help="also record every step into FILE (.parquet or .csv)")
     p.add_argument("--replay", metavar="FILE", default=None, help="play a recording back, with a timeline")
     p.add_argument("--at", type=float, default=None, metavar="T", help="--replay: start at simulated time T (s)")
+    p.add_argument("--events", metavar="FILE|-", default=None,
+                   help="write what happens as JSON lines (ready with the page's address, ..., stopped): docs/events.md")
     p.set_defaults(func=lambda args: _view(args, open_cell), lockstep=False)
 
     p = sub.add_parser("plot", help="plot signals of a recording against simulated time (PNG or SVG)",

@@ -17,6 +17,8 @@ from pathlib import Path
 
 from twin.core.errors import SignalError, SignalRangeError, TwinError
 
+PAGE_START_TIMEOUT = 60.0  # s the cell waits for the page's process to listen before it runs without it
+
 
 def check_write(spec: dict, value) -> str | None:
     """Why the twin would refuse `value` (SI) for the signal `spec` (a Scene signal), or None when it takes it.
@@ -137,7 +139,16 @@ class ViewFrontEnd:
         self.live = LiveView(cell.twin, cell.exchange, cell.runner, host=self.host, port=self.port)
         if self.on_ready is not None:
             self.on_ready(self.live)
+        # the page's process is up (or failed) before the cell runs, so `ready` can say where it is
+        await asyncio.get_running_loop().run_in_executor(None, self.live.page.ready.wait, PAGE_START_TIMEOUT)
         return []  # the page says "view on URL" once it is up
+
+    def endpoints(self) -> list[dict]:
+        """Where the page is, for the `ready` event (`twin.events`); nothing if it did not start."""
+        if self.live is None or self.live.page.port is None:
+            return []
+        return [{"name": self.name, "protocol": "http", "host": self.host, "port": self.live.page.port,
+                 "url": self.live.url}]
 
     async def close(self) -> None:
         if self.live is not None:
@@ -159,6 +170,9 @@ class RecorderFrontEnd:
         self.recorder = Recorder(cell.twin, self.path)
         return [f"recording every step into {self.path}"]
 
+    def endpoints(self) -> list[dict]:
+        return [{"name": self.name, "file": str(self.path)}]
+
     async def close(self) -> None:
         if self.recorder is not None:
             from twin.modbus.log import announce
@@ -179,25 +193,34 @@ def front_ends_from_args(args) -> list:
 
 # -- `twin view STATION` ---------------------------------------------------------------------------------------------
 def cmd_view(args, open_cell) -> int:
-    """`twin view`: `open_cell(station)` (the application's) gives the cell; the page (and a recorder) serve it."""
+    """`twin view`: `open_cell(station, events)` (the application's) gives the cell; the page (and a recorder)
+    serve it. `--events FILE|-`: the machine interface (`twin.events`)."""
+    from twin.events import Events
     from twin.modbus.log import announce as log
 
-    if args.replay is not None:
-        from .replay import run_replay
+    try:
+        events = Events.open(getattr(args, "events", None))
+    except OSError as exc:
+        raise TwinError(f"--events {args.events}: {exc.strerror or exc}") from None
+    try:
+        if args.replay is not None:
+            from .replay import run_replay
 
-        return run_replay(args.replay, host=args.host, port=args.port, at=args.at)
-    if args.station is None:
-        raise TwinError("twin view needs a STATION (or --replay FILE)")
-    try:
-        import viser  # noqa: F401
-    except ImportError:
-        raise TwinError("the live view needs viser: pip install 'gripper-twin[view]'") from None
-    log(f"loading station {args.station}")
-    cell = open_cell(Path(args.station))
-    try:
-        if args.record is not None:
-            cell.add_front_end(RecorderFrontEnd(args.record))
-        cell.add_front_end(ViewFrontEnd(host=args.host, port=args.port))
-        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, paused=args.paused))
+            return run_replay(args.replay, host=args.host, port=args.port, at=args.at, events=events)
+        if args.station is None:
+            raise TwinError("twin view needs a STATION (or --replay FILE)")
+        try:
+            import viser  # noqa: F401
+        except ImportError:
+            raise TwinError("the live view needs viser: pip install 'gripper-twin[view]'") from None
+        log(f"loading station {args.station}")
+        cell = open_cell(Path(args.station), events)
+        try:
+            if args.record is not None:
+                cell.add_front_end(RecorderFrontEnd(args.record))
+            cell.add_front_end(ViewFrontEnd(host=args.host, port=args.port))
+            return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, paused=args.paused))
+        finally:
+            cell.close()
     finally:
-        cell.close()
+        events.close()

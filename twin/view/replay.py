@@ -6,6 +6,7 @@ against the wall clock, Pause stops it, Step and Back move one recorded step.
 """
 from __future__ import annotations
 
+import os
 import signal
 import threading
 import time
@@ -101,7 +102,9 @@ class ReplayControls:
 
 
 def run_replay(path, *, host: str = "127.0.0.1", port: int = 8080, at: float | None = None,
-               stop: threading.Event | None = None, on_ready=None) -> int:
+               stop: threading.Event | None = None, on_ready=None, events=None) -> int:
+    """Serve a recording's page until stopped; `events` (`twin.events.Events`): `ready` with the page's address,
+    `stopped` at the end."""
     from twin.core.errors import TwinError
 
     try:
@@ -122,6 +125,9 @@ def run_replay(path, *, host: str = "127.0.0.1", port: int = 8080, at: float | N
     loop = FrameLoop(page, controls.frame, before=controls.advance).start()
     announce(f"replaying {rec.path} ({len(rec)} steps, {rec.time[-1]:.3f} s)")
     announce(f"view on http://{host}:{page.port}")
+    if events is not None:
+        events.emit("ready", pid=os.getpid(), recording=str(rec.path), front_ends=[
+            {"name": "view", "protocol": "http", "host": host, "port": page.port, "url": f"http://{host}:{page.port}"}])
     stop = stop or threading.Event()
     previous = {}
     if threading.current_thread() is threading.main_thread():
@@ -137,4 +143,6 @@ def run_replay(path, *, host: str = "127.0.0.1", port: int = 8080, at: float | N
             signal.signal(sig, handler)
         loop.stop()
         page.close()
+        if events is not None:
+            events.emit("stopped", steps=len(rec), requests=0)
     return 0
