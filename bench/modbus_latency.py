@@ -25,12 +25,12 @@ from __future__ import annotations
 import argparse
 import asyncio
 import os
-import re
 import socket
 import statistics
 import struct
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -41,24 +41,29 @@ DEFAULT_STATION = ROOT / "stations" / "ring_rig"  # the thesis rig: arm, 3-finge
 
 # -- the servers --------------------------------------------------------------------------------------------
 class Server:
-    def __init__(self, cmd: list[str], port_from_log: bool, port: int | None = None):
+    def __init__(self, cmd: list[str], port_from_events: bool, port: int | None = None):
+        """`port_from_events`: a `twin serve` command; it gets `--events FILE` and its ports come from `ready`."""
+        self.events = None
+        if port_from_events:
+            from plc_client.events import EventLog
+
+            self._dir = tempfile.TemporaryDirectory(prefix="bench-serve-")
+            path = Path(self._dir.name) / "events.jsonl"
+            cmd = [*cmd, "--events", str(path)]
         self.proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=ROOT,
                                      env={**os.environ, "PYTHONUNBUFFERED": "1"})
         self.port = port
         self.lines: list[str] = []
-        found = threading.Event()
 
         def drain():
             for line in self.proc.stderr:
                 self.lines.append(line)
-                if port_from_log and (m := re.search(r"listening on [\d.]+:(\d+)", line)):
-                    self.port = int(m.group(1))
-                    found.set()
-            found.set()
 
         threading.Thread(target=drain, daemon=True).start()
-        if port_from_log:
-            found.wait(60)
+        if port_from_events:
+            self.events = EventLog(path, self.proc)
+            if self.events.wait("ready", 120) is not None:
+                self.port = next((f["port"] for f in self.events.seen[-1]["front_ends"] if f["name"] == "modbus"), None)
         end = time.monotonic() + 30
         while True:
             try:
@@ -261,11 +266,11 @@ def main(argv: list[str] | None = None) -> int:
     py = sys.executable
     results: dict[str, dict[str, float]] = {}
 
-    twin = Server([py, "-m", "twin", "serve", args.station, "--port", "0"], port_from_log=True)
+    twin = Server([py, "-m", "twin", "serve", args.station, "--port", "0"], port_from_events=True)
     port = free_port()
     try:
         bare = Server([py, "-m", "bench.modbus_latency", "--bare-server", str(port), *map(str, sizes)],
-                      port_from_log=False, port=port)
+                      port_from_events=False, port=port)
     except Exception:
         twin.stop()
         raise

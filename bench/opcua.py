@@ -44,34 +44,14 @@ UNIT = 1
 
 
 class TwinServer(Server):
-    """`twin serve STATION --opcua 0 --port 0` in real time; its Modbus port and OPC UA endpoint from its log
+    """`twin serve STATION --opcua 0 --port 0` in real time; its Modbus port and OPC UA endpoint from its events
     (started here; stopped as bench modbus stops its servers)."""
 
     def __init__(self, station: Path):
         cert_dir = ROOT / ".pytest_cache" / "bench-opcua-certs"
-        self.proc = subprocess.Popen([sys.executable, "-m", "twin", "serve", str(station), "--port", "0", "--opcua", "0",
-                                      "--opcua-cert-dir", str(cert_dir)],
-                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=ROOT,
-                                     env={**os.environ, "PYTHONUNBUFFERED": "1"})
-        self.lines: list[str] = []
-        self.port, self.url = None, None
-        ready = threading.Event()
-
-        def drain():
-            for line in self.proc.stderr:
-                self.lines.append(line)
-                if m := re.search(r"^twin serve: listening on [\d.]+:(\d+)", line):
-                    self.port = int(m.group(1))
-                if m := re.search(r"OPC UA listening on (\S+)", line):
-                    self.url = m.group(1)
-                    ready.set()
-            ready.set()
-
-        threading.Thread(target=drain, daemon=True).start()
-        ready.wait(120)
-        if self.url is None or self.port is None:
-            self.stop()
-            raise RuntimeError("twin serve did not start:\n" + "".join(self.lines))
+        super().__init__([sys.executable, "-m", "twin", "serve", str(station), "--port", "0", "--opcua", "0",
+                          "--opcua-cert-dir", str(cert_dir)], port_from_events=True)
+        self.url = self.events.endpoint("opcua")["url"]
 
     def cpu_seconds(self) -> float:
         """User + system CPU time of the server process so far (Linux /proc)."""
