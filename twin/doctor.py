@@ -195,6 +195,36 @@ class _Reach:
             self._restore(saved)
         return max(servos, key=lambda n: travel[n])
 
+    def _shape_centre(self, finger: str):
+        """The centre of the finger's collision shapes' bounding box in the world (a revolute finger's link frame,
+        and often its centre of mass, sits on its pivot and hardly moves as it turns; its shapes do)."""
+        boxes = [self.c.getAABB(self.body, link) for link in self.g.finger_links[finger]]
+        return [(min(b[0][i] for b in boxes) + max(b[1][i] for b in boxes)) / 2 for i in range(3)]
+
+    def closing(self, drive: str) -> float:
+        """+1 or -1: the way of `drive` that brings the fingers' shapes together (their spread about their centre
+        shrinks), from a small move of the joint (put back)."""
+        fingers = list(self.g.finger_links)
+
+        def points():
+            pts = [self._shape_centre(f) for f in fingers]
+            if len(pts) == 1:
+                pts.append(self.c.getBasePositionAndOrientation(self.body)[0])
+            return pts
+
+        saved = self._saved()
+        try:
+            pts = points()
+            centre = [sum(p[i] for p in pts) / len(pts) for i in range(3)]
+            base = sum(math.dist(p, centre) for p in pts)
+            inp, q = self.twin.mechanism.input(drive), self.twin.read(drive)
+            delta = (0.001 if inp.unit == "m" else 0.01) * (1 if q + 0.001 <= inp.max else -1)
+            self._set(drive, q + delta)
+            moved = sum(math.dist(p, centre) for p in points()) - base
+        finally:
+            self._restore(saved)
+        return (-1.0 if moved > 0 else 1.0) * (1 if delta > 0 else -1)
+
     def lift_axis(self, closing: set, gravity) -> tuple[str, float] | None:
         """A prismatic input that moves every finger alike, against gravity (a gantry's lift): (its name, +1 or -1,
         the direction that lifts). None if there is none."""
@@ -229,7 +259,7 @@ class _Reach:
         where it touches the bore's wall opening from inside (`inside`, with the free room `bore`), and its
         distance at the closed end; positions of the drive's joint."""
         inp = self.twin.mechanism.input(drive)
-        closing = self.g.closing[drive]
+        closing = self.closing(drive)
         open_end, closed_end = (inp.min, inp.max) if closing > 0 else (inp.max, inp.min)
         qs = [open_end + (closed_end - open_end) * k / SWEEP_SAMPLES for k in range(SWEEP_SAMPLES + 1)]
         saved = self._saved()
@@ -422,6 +452,12 @@ class Doctor:
             return self.report
         self.rest()
         drive_of = {f: self.reach.closing_drive(f) for f in self.fingers}
+        for d in sorted({d for d in drive_of.values() if d is not None}, key=list(self.g.joint).index):
+            mine, twins = self.reach.closing(d), self.g.closing[d]
+            if mine != twins:
+                sign = {1.0: "increasing", -1.0: "decreasing"}
+                self.check(FAIL, "station", d, "closing", f"its fingers close with {sign[mine]} {d}, the twin takes "
+                           f"{sign[twins]} {d} for closing (its status 2 and 1 are swapped)")
         if self.twin.robot is None:
             self.lift_axis = self.reach.lift_axis(set(drive_of.values()), self.twin.station.gravity)
         for body in st.targets:
@@ -776,6 +812,7 @@ def format_report(report: Report) -> str:
     by_where: dict[str, list[Check]] = {}
     for c in report.checks:
         by_where.setdefault(c.where, []).append(c)
+    lines += [c.line() for c in by_where.pop("station", [])]
     for name, creep in report.rest_creep.items():
         lines += [f"{name}: resting on its support"] + ["  " + c.line() for c in by_where.pop(f"{name} resting", [])]
     for grip in report.grips:
