@@ -389,19 +389,26 @@ class Doctor:
         return mount * Pose.from_xyz_rpy(st.gripper.tcp.xyz, st.gripper.tcp.rpy)
 
     def grip_pose(self, name: str) -> Pose:
-        """Where the TCP grips the part: a station robot target at the part's centre (its author's choice of
-        orientation), else the part's centre with the TCP's present orientation; without a robot, where it is."""
+        """Where the TCP grips the part: the station's robot target at the part's placement (its author's height
+        and orientation; within half the part's height), moved with the part if it has moved since; else the
+        part's centre with the TCP's present orientation. Without a robot, where the gripper is."""
         here = self.tcp()
         if self.twin.robot is None:
             return here
-        centre = self.part_pose(name).position
+        body = self.spec[name]
+        placed = Pose.from_xyz_rpy(body.pose.xyz, body.pose.rpy).position
+        now = self.part_pose(name).position
+        lo, hi = self.c.getAABB(self.twin.world.body_ids[name])
+        tolerance = max(0.01, (hi[2] - lo[2]) / 2)
         best = None
         for tname in self.twin.station.robot_targets:
             pose = self.twin.target(tname)
-            d = float(sum((pose.position - centre) ** 2) ** 0.5)
-            if d <= 0.01 and (best is None or d < best[0]):
+            d = float(sum((pose.position - placed) ** 2) ** 0.5)
+            if d <= tolerance and (best is None or d < best[0]):
                 best = (d, pose)
-        return best[1] if best else Pose(centre, here.orientation)
+        if best is None:
+            return Pose(now, here.orientation)
+        return Pose(best[1].position + (now - placed), best[1].orientation)
 
     def backed_off(self, pose: Pose, distance: float) -> Pose:
         """`pose` moved back along its tool axis (z) by `distance`: out of the part, the way it came in."""
@@ -461,8 +468,8 @@ class Doctor:
         if self.twin.robot is None:
             self.lift_axis = self.reach.lift_axis(set(drive_of.values()), self.twin.station.gravity)
         for body in st.targets:
-            plans = self.plan(body.name, drive_of)
             for mode in ("outside", "inside"):
+                plans = self.plan(body.name, drive_of)  # where the part is now (an earlier grip may have moved it)
                 result = GripResult(body.name, mode)
                 self.report.grips.append(result)
                 try:

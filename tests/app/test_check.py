@@ -312,3 +312,10 @@ def test_a_ring_the_fingers_can_hold_only_from_inside_is_no_reach_failure(tmp_pa
     assert any(" reach: " in ln for ln in lines(text, "INFO")), text
     inside = grip(report, "ring", "inside")
     assert not inside["skipped"] and all(f["onset_step"] is not None for f in inside["fingers"])
+
+
+def test_the_same_station_gives_the_same_report(tmp_path, capsys):
+    """The doctor drives the twin by steps alone: twice the same station, bit for bit the same measures."""
+    first = run_check(STATIONS / "smart_gripper", tmp_path, capsys)[2]
+    second = run_check(STATIONS / "smart_gripper", tmp_path, capsys)[2]
+    assert first == second
