@@ -390,14 +390,14 @@ class Doctor:
 
     def grip_pose(self, name: str) -> Pose:
         """Where the TCP grips the part: the station's robot target at the part's placement (its author's height
-        and orientation; within half the part's height), moved with the part if it has moved since; else the
+        and orientation; within half the part's height), moved and turned with the part since; else the
         part's centre with the TCP's present orientation. Without a robot, where the gripper is."""
         here = self.tcp()
         if self.twin.robot is None:
             return here
         body = self.spec[name]
-        placed = Pose.from_xyz_rpy(body.pose.xyz, body.pose.rpy).position
-        now = self.part_pose(name).position
+        placed_pose = Pose.from_xyz_rpy(body.pose.xyz, body.pose.rpy)
+        placed, now = placed_pose.position, self.part_pose(name).position
         lo, hi = self.c.getAABB(self.twin.world.body_ids[name])
         tolerance = max(0.01, (hi[2] - lo[2]) / 2)
         best = None
@@ -408,7 +408,7 @@ class Doctor:
                 best = (d, pose)
         if best is None:
             return Pose(now, here.orientation)
-        return Pose(best[1].position + (now - placed), best[1].orientation)
+        return self.part_pose(name) * placed_pose.inverse() * best[1]  # moved and turned as the part was
 
     def backed_off(self, pose: Pose, distance: float) -> Pose:
         """`pose` moved back along its tool axis (z) by `distance`: out of the part, the way it came in."""

@@ -269,8 +269,11 @@ def test_the_ring_rig_is_gripped_from_outside_and_inside_and_lifted(tmp_path, ca
     for g, contact in ((outside, ring["outer_diameter"] / 2), (inside, ring["inner_diameter"] / 2 - face)):
         assert not g["skipped"], g["skipped"]
         assert {f["finger"] for f in g["fingers"]} == {"L2", "L3", "L5"}
-        for f in g["fingers"]:
-            assert f["contact_geometry"] == pytest.approx(contact, abs=0.1e-3), f
+        # the part may have moved a little since it was placed (the inside grip follows the outside one): for three
+        # fingers 120 degrees apart an offset moves their contacts by amounts that sum to zero
+        contacts = [f["contact_geometry"] for f in g["fingers"]]
+        assert sum(contacts) / 3 == pytest.approx(contact, abs=0.1e-3), contacts
+        assert all(c == pytest.approx(contact, abs=2e-3) for c in contacts), contacts
         assert g["lift_slip"] is not None  # the robot lifted it
     assert {f["drive"] for f in outside["fingers"]} == {"L2", "L3", "L4"}  # finger L5 rides on L4's carriage
     from PIL import Image
