@@ -16,6 +16,7 @@ BENCHMARKS = {
     "opcua": "bench.opcua",  # OPC UA vs Modbus on the same cell: latency, change delay, 1000 monitored items
     "view": "bench.view",  # the live page and recording: late steps, page updates per s, recording cost per step
     "map": "bench.signal_map",  # twin map from the static signal table vs from a running cell
+    "pollimage": "bench.poll_image",  # a master reading a poll in two requests: torn images with and without the hold
 }
 
 

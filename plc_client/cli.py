@@ -1,6 +1,7 @@
 """The `plc` command: manual pokes at a running twin server, signals by name in engineering units.
 
-    plc [--host H] [--port P] [--unit-id U] (--map FILE.json | --station DIR) COMMAND
+    plc [--host H] [--port P] [--unit-id U] [--map FILE.json | --station DIR] COMMAND
+        (without --map or --station: the map the server serves, read from it with function 20)
         read NAME...                      one line per signal: name, value, unit (an enumeration such as
                                           GrippedPart: its index, then its text: `GrippedPart  1  (ring)`)
         write NAME=VALUE...               checked first: one bad name or value and nothing is written;
@@ -121,11 +122,17 @@ def cmd_demo(args) -> int:
 
 # -- commands ---------------------------------------------------------------------------------------------
 def load_map(args) -> RegisterMap:
+    """--map, --station, else the map the server at --host/--port serves (function 20)."""
     if args.map:
         return RegisterMap.from_json(args.map)
     if args.station:
         return RegisterMap.from_station(args.station)
-    raise UsageError("no register map: give --map FILE.json (from `twin map STATION --format json`) or --station DIR")
+    from .client import fetch_map
+
+    tls = tls_files(args)
+    if args.port is None:
+        args.port = TLS_PORT if tls is not None else DEFAULT_PORT
+    return fetch_map(args.host, args.port, args.unit_id, timeout=args.timeout, tls=tls)
 
 
 def tls_files(args):

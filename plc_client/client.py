@@ -131,6 +131,68 @@ class WindowImage:
         return self.words[lay.in_offset[HOLDING_REGISTER] + k - lay.out_offset[HOLDING_REGISTER]]
 
 
+_SERVED_MAPS: dict[int, RegisterMap] = {}  # CRC-32 -> a map fetched from a server
+
+
+def fetch_map(host: str = "127.0.0.1", port: int = DEFAULT_PORT, unit_id: int = 1, *, timeout: float = 3.0,
+              tls: TlsFiles | None = None) -> RegisterMap:
+    """The register map a running server serves, read from the server itself (function 20, read file record:
+    `twin.modbus.pdu.MapFile`): first its CRC-32 and length, then the JSON, unless a map of that CRC was
+    fetched before (a server restarted with another map has another CRC, so it is fetched anew). A document
+    whose JSON does not have the CRC it came with is a MapError."""
+    import struct
+
+    from pymodbus.client import ModbusTcpClient, ModbusTlsClient
+    from pymodbus.exceptions import ModbusException
+    from pymodbus.pdu.file_message import FileRecord
+
+    from twin.modbus.pdu import MAP_FILE, RECORDS_PER_FILE
+
+    if tls is not None:
+        client = ModbusTlsClient(host, port=port, sslctx=tls.context(), timeout=timeout, retries=0)
+    else:
+        client = ModbusTcpClient(host, port=port, timeout=timeout, retries=0)
+    try:
+        if not client.connect():
+            raise ConnectionFailedError(host, port, "connection refused or timed out")
+
+        def records(first: int, count: int) -> bytes:
+            file, record = MAP_FILE + first // RECORDS_PER_FILE, first % RECORDS_PER_FILE
+            try:
+                r = client.read_file_record([FileRecord(file_number=file, record_number=record, record_length=2 * count)],
+                                            device_id=unit_id)
+            except (ModbusException, OSError) as exc:
+                raise ConnectionFailedError(host, port, str(exc).strip() or type(exc).__name__) from None
+            if r.isError():
+                code = getattr(r, "exception_code", 0)
+                if code == 1:
+                    raise MapError(f"the server at {host}:{port} does not serve its register map (function 20 answered "
+                                   "exception 01: an older twin serve?); give --map FILE.json or --station DIR") from None
+                raise ModbusExceptionError(code, 20, first, count, unit_id, ("the register map",))
+            return bytes(r.records[0].record_data)
+
+        crc, length = struct.unpack(">II", records(0, 4))
+        if crc in _SERVED_MAPS:
+            return _SERVED_MAPS[crc]
+        total, data = (length + 1) // 2, bytearray()
+        while len(data) < 2 * total:
+            at = 4 + len(data) // 2
+            n = min(MAX_READ_REGISTERS - 1, total - len(data) // 2, RECORDS_PER_FILE - at % RECORDS_PER_FILE)
+            data += records(at, n)
+    finally:
+        client.close()
+    where = f"the map served at {host}:{port}"
+    try:
+        rmap = RegisterMap.from_json(bytes(data[:length]).decode("utf-8"))
+    except UnicodeDecodeError:
+        raise MapError(f"{where}: not UTF-8 text") from None
+    rmap = RegisterMap(rmap.entries, rmap.station, source=where, meta=rmap.meta)
+    if rmap.crc != crc:
+        raise MapError(f"{where}: its JSON has CRC {rmap.crc:#010x}, the server announced {crc:#010x}")
+    _SERVED_MAPS[crc] = rmap
+    return rmap
+
+
 class TwinClient:
     """A connection to a twin server, signals by name (see the module's docstring)."""
 
@@ -151,7 +213,8 @@ class TwinClient:
     def connect(cls, host: str = "127.0.0.1", port: int | None = None, unit_id: int = 1, *,
                 map: str | Path | RegisterMap | None = None, station: str | Path | None = None, timeout: float = 3.0,
                 tls: TlsFiles | None = None, heartbeat: float | str | None = "auto") -> "TwinClient":
-        """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`.
+        """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`, else the map
+        the server serves (`fetch_map`).
         `tls`: Modbus/TCP Security with these certificate files (port default 802, else 5020: `twin.modbus.protocol`).
         `heartbeat`: see `TwinClient` (a request at least that often, so the server's watchdog sees a quiet
         but healthy PLC)."""
@@ -164,7 +227,7 @@ class TwinClient:
         elif station is not None:
             rmap = RegisterMap.from_station(station)
         else:
-            raise MapError("no register map: give map=FILE.json (from `twin map STATION --format json`) or station=DIR")
+            rmap = fetch_map(host, port, unit_id, timeout=timeout, tls=tls)  # the server's own (function 20)
         client = cls(rmap, host, port, unit_id, timeout, tls=tls, heartbeat=heartbeat)
         client.open()
         return client

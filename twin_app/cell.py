@@ -15,7 +15,8 @@ What a `Cell` holds:
 - `twin` (`twin.core.Twin`) and `controller`: the station's `[controller]` (a RAPID program, `rapid_like`)
   attached to the twin through the core's `Device` protocol; the core imports no controller.
 - `watchdog` (`twin.watchdog`): the comm-loss watchdog, a device too; front ends `feed` it per request.
-- `register_map`: the Modbus map of `signals` (its CRC is published as `sim.map_crc` to every front end).
+- `register_map`: the Modbus map of `signals` in the layout asked for (its CRC is published as `sim.map_crc` to
+  every front end).
 - `exchange` (`twin.exchange.Exchange`): the ONE way front ends see and change the cell.
 - one runner (`twin.pacing`): real time (`speed` x the wall clock) or lockstep (steps on `sim.advance`).
 
@@ -96,7 +97,7 @@ class Cell:
 
     def __init__(self, station: str | Path | Station, on_event: Callable[[dict], None] | None = None, *,
                  entry: str | None = None, log: Callable[..., None] = _log, announce: Callable[[str], None] = _announce,
-                 publish: bool = True, events: Events | None = None):
+                 publish: bool = True, events: Events | None = None, layout: str = ""):
         """Load a station (a folder, a station.toml, or a `Station`, e.g. one with a campaign's parameters
         applied); if it has a `[controller]`, its RAPID program runs as the robot controller.
 
@@ -106,12 +107,14 @@ class Cell:
         `publish=False`: in-process steps take no snapshot (see the module docstring).
         `events`: the machine interface (`twin.events`, `twin serve --events`): the cell, its controller,
         its watchdog and its front ends write what happens there.
+        `layout`: the register map's (`twin.modbus.register_map.LAYOUTS`; default the signals layout, `twin serve
+        --layout plc` the PLC's).
         """
         self.publishing = publish
         self.events = events if events is not None else Events()
         self.station = station if isinstance(station, Station) else load_station(station)
         self.signals = station_signals(self.station)
-        self.register_map: RegisterMap = build_register_map(self.signals, self.station.name)
+        self.register_map: RegisterMap = build_register_map(self.signals, self.station.name, layout)
         self.log, self.announce = log, announce  # log(text, level); announce: shown at every log level
         self.twin = Twin(self.station)
         twin = self.twin

@@ -2,7 +2,7 @@
 
     twin info STATION_OR_URDF [--json]
     twin serve STATION [Modbus flags: twin.modbus.cli] [--realtime | --lockstep] [--speed X]
-    twin map STATION [--format json|csv|md]
+    twin map STATION [--format json|csv|md|st|openplc] [--layout signals|plc]
     twin demo [STATION] [OPTIONS]  (a station's demo: its station.toml's [plugins] twin_demo)
     twin campaign ... (twin_app.campaign)
     twin check STATION [-o grip.png] [--json FILE] [--hold S]  (the station doctor: twin.doctor)
@@ -165,12 +165,12 @@ class _StartUpSignals:
             signal.signal(sig, handler)
 
 
-def open_served_cell(station, events=None):
+def open_served_cell(station, events=None, layout: str = ""):
     """A station's cell as the servers run it, its robot controller's words in the log (and, with `events`,
-    in the machine interface: `twin.events`)."""
+    in the machine interface: `twin.events`); `layout`: the register map's (`twin serve --layout`)."""
     from .cell import Cell
 
-    return Cell(Path(station), on_event=controller_log, events=events)
+    return Cell(Path(station), on_event=controller_log, events=events, layout=layout)
 
 
 def cmd_serve(args) -> int:
@@ -204,7 +204,7 @@ def cmd_serve(args) -> int:
         announce(f"loading station {args.station}")
         from twin.modbus.front_end import ModbusFrontEnd
 
-        cell = open_served_cell(args.station, events)
+        cell = open_served_cell(args.station, events, getattr(args, "layout", None) or "")
         if getattr(args, "faults", None):
             from twin.faults import FaultInjector
 

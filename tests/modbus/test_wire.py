@@ -39,7 +39,7 @@ def advance(raw: Raw, n: int) -> None:
 
 
 # -- exception responses: function code | 0x80, the right code ---------------------------------------------
-@pytest.mark.parametrize("fc", [7, 8, 17, 20, 43, 0x41])
+@pytest.mark.parametrize("fc", [7, 8, 17, 21, 43, 0x41])  # 20 (read file record) serves the map
 def test_an_unknown_function_is_answered_with_its_own_code_and_the_high_bit_and_exception_01(raw, fc):
     assert raw.request(bytes([fc]) + b"\x00\x00\x00\x01") == exception(fc, 0x01)
 

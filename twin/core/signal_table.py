@@ -30,7 +30,9 @@ from __future__ import annotations
 
 from .errors import StationError
 from .mechanism import Mechanism, load_mechanism
-from .signals import BOOL, ENUM, FLOAT, INPUT, INT, OUTPUT, SignalSpec
+from dataclasses import replace
+
+from .signals import BOOL, ENUM, FLOAT, INPUT, INT, OPERATOR, OUTPUT, PLC, ROBOT, SIMULATOR, SignalSpec
 from .station import ControllerSpec, Station, load_station
 
 # Groups (where a signal belongs; front ends organise their address space by them).
@@ -59,7 +61,7 @@ U16_MAX = 0xFFFF
 
 
 def _sim(name, direction, type_, unit, lo, hi, description) -> SignalSpec:
-    return SignalSpec(name, direction, type_, unit, lo, hi, description, group=SIM)
+    return SignalSpec(name, direction, type_, unit, lo, hi, description, group=SIM, owner=SIMULATOR)
 
 
 # Published by the exchange (the runner's state), not by the twin: `SIM_NAMES`.
@@ -115,10 +117,10 @@ def gripper_signals(station: Station, mechanism: Mechanism) -> list[SignalSpec]:
     """`Active`, the joint inputs, the grip outputs, per input its state, per finger contact and force."""
     m, st = mechanism, station
     targets = tuple(t.name for t in st.targets)
-    sig = [SignalSpec("Active", INPUT, BOOL, description="gripper enable: while low the fingers hold still"
+    sig = [SignalSpec("Active", INPUT, BOOL, owner=PLC, description="gripper enable: while low the fingers hold still"
                       + (" (this station's gripper is always active)" if st.gripper.always_active else ""))]
     for inp in m.inputs:
-        sig.append(SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max,
+        sig.append(SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max, owner=PLC, description=
                               f"setpoint of {inp.type} joint {inp.joint}" + (f" ({inp.note})" if inp.note else "")))
     sig.append(SignalSpec("doGripped", OUTPUT, BOOL, description="every finger presses on the same target with at least "
                           "its grip force" + (f" ({st.gripper.grip_force:g})" if st.gripper.grip_force else "")))
@@ -152,16 +154,16 @@ def gripper_signals(station: Station, mechanism: Mechanism) -> list[SignalSpec]:
 def robot_signals(station: Station) -> list[SignalSpec]:
     if station.robot is None:
         return []
-    sig = [SignalSpec("robot.busy", OUTPUT, BOOL, group=ROBOT, description="the robot is executing a motion")]
+    sig = [SignalSpec("robot.busy", OUTPUT, BOOL, group=ROBOT, owner=ROBOT, description="the robot is executing a motion")]
     for i, _ in enumerate(station.robot.joints, start=1):
-        sig.append(SignalSpec(f"robot.j{i}", OUTPUT, FLOAT, "rad", group=ROBOT, description=f"robot axis {i} position"))
+        sig.append(SignalSpec(f"robot.j{i}", OUTPUT, FLOAT, "rad", group=ROBOT, owner=ROBOT, description=f"robot axis {i} position"))
     return sig
 
 
 def target_signals(station: Station) -> list[SignalSpec]:
     sig = []
     for t in station.targets:
-        sig.append(SignalSpec(f"{t.name}.present", INPUT, BOOL, group=TARGETS,
+        sig.append(SignalSpec(f"{t.name}.present", INPUT, BOOL, group=TARGETS, owner=SIMULATOR,
                               description=f"{t.name} is in the cell: write 0 to take it away (a missing part), "
                                           "1 to put it back where the station places it"))
         for axis in "xyz":
@@ -211,20 +213,28 @@ def _wiring(sig) -> str:
     return "set from outside"
 
 
+def controller_owner(sig) -> str:
+    """Who a controller signal belongs to: an input no twin output feeds (DI, AI, GI) is the PLC's answer to the
+    robot; a `settable` output the operator's (the I/O simulator); everything else the robot controller's."""
+    if settable_from_outside(sig):
+        return OPERATOR if sig.settable and sig.type in ("DO", "AO", "GO") else PLC
+    return ROBOT
+
+
 def controller_signals(spec: ControllerSpec) -> tuple[SignalSpec, ...]:
     """The robot controller's signals: its declared I/O, then the program-control signals `rapid.*`."""
     specs = [SignalSpec(sig.name, INPUT if settable_from_outside(sig) else OUTPUT, CONTROLLER_SIGNAL_TYPE[sig.type],
                         sig.unit, description=f"robot controller {sig.type} {sig.name} ({_wiring(sig)})",
-                        group=CONTROLLER)
+                        group=CONTROLLER, owner=controller_owner(sig))
              for sig in spec.io]
     specs += [
-        SignalSpec(RAPID_START, INPUT, BOOL, group=CONTROLLER,
+        SignalSpec(RAPID_START, INPUT, BOOL, group=CONTROLLER, owner=OPERATOR,
                    description="a rising edge (re)starts the RAPID program from its entry routine (VAR data anew, PERS kept)"),
-        SignalSpec(RAPID_STOP, INPUT, BOOL, group=CONTROLLER, description="a rising edge stops the RAPID program where it is"),
-        SignalSpec(RAPID_RUNNING, OUTPUT, BOOL, group=CONTROLLER, description="the RAPID program is running (or waiting)"),
-        SignalSpec(RAPID_ERROR, OUTPUT, BOOL, group=CONTROLLER,
+        SignalSpec(RAPID_STOP, INPUT, BOOL, group=CONTROLLER, owner=OPERATOR, description="a rising edge stops the RAPID program where it is"),
+        SignalSpec(RAPID_RUNNING, OUTPUT, BOOL, group=CONTROLLER, owner=ROBOT, description="the RAPID program is running (or waiting)"),
+        SignalSpec(RAPID_ERROR, OUTPUT, BOOL, group=CONTROLLER, owner=ROBOT,
                    description="the RAPID program stopped on a runtime error (the server's log says where)"),
-        SignalSpec(RAPID_LINE, OUTPUT, INT, min=0, max=65535, group=CONTROLLER,
+        SignalSpec(RAPID_LINE, OUTPUT, INT, min=0, max=65535, group=CONTROLLER, owner=ROBOT,
                    description="the line of the program's module the robot controller waits at (0: none)"),
     ]
     return tuple(specs)
@@ -267,6 +277,8 @@ def station_signals(station: Station | str, *, sim: bool = True) -> tuple[Signal
     table = list(own) + list(watchdog_signals(watchdog.safe_state if watchdog is not None else "hold"))
     if station.controller is not None:
         check_wiring(station, tuple(table))
+        driven = {sig.drives for sig in station.controller.io if sig.drives}
+        table = [replace(s, owner=ROBOT) if s.name in driven else s for s in table]  # the robot's, not a PLC's
         table += controller_signals(station.controller)
     if sim:
         table += SIM_SIGNALS

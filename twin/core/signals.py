@@ -21,6 +21,11 @@ FLOAT = "float"  # a physical quantity in `unit`
 INT = "int"      # a count (steps, ...)
 ENUM = "enum"    # one of `choices`; read as the choice's text, index 0 means "none"
 
+# Who a signal belongs to (`SignalSpec.owner`): for an input, who writes it in the real cell; for an output, who
+# produces it. A Modbus master PLC is configured to write exactly the PLC's inputs (the register map's PLC layout).
+PLC, ROBOT, OPERATOR, SIMULATOR = "plc", "robot", "operator", "simulator"
+OWNERS = (PLC, ROBOT, OPERATOR, SIMULATOR)
+
 #: The units a PLC, the register map, a plot and the live page show instead of an SI unit: SI unit ->
 #: (engineering unit, factor), SI value * factor = the value shown. Other units are shown as they are.
 ENGINEERING_UNITS = {"m": ("mm", 1000.0), "rad": ("deg", 180.0 / math.pi)}
@@ -44,6 +49,13 @@ class SignalSpec:
     description: str = ""
     group: str = "gripper"  # gripper, robot, controller or sim: where the signal belongs
     choices: tuple[str, ...] = field(default=())  # ENUM only; choices[0] == "" (none)
+    # PLC, ROBOT, OPERATOR or SIMULATOR ("": an input is the operator's, an output the simulator's). Not compared:
+    # the station's wiring decides it (an input a robot signal drives is the robot's), the twin's own table cannot.
+    owner: str = field(default="", compare=False)
+
+    @property
+    def owned_by(self) -> str:
+        return self.owner or (OPERATOR if self.direction == INPUT else SIMULATOR)
 
     @property
     def writable(self) -> bool:

@@ -24,6 +24,7 @@ from twin.cli_args import nonnegative_float, positive_float, positive_int, tcp_p
 
 from .log import LEVELS, log as _log
 from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT
+from .register_map import POLL_HOLD
 
 
 def _unit(text: str) -> int:
@@ -56,13 +57,33 @@ def add_commands(subparsers, cmd_serve):
                               description="Print the register map `twin serve` serves for a station (from the station's "
                                           "files: no physics, no robot program).")
     p.add_argument("station", help="a station folder or station.toml")
-    p.add_argument("--format", choices=("json", "csv", "md"), default="md", help="output format (default md)")
+    p.add_argument("--format", choices=("json", "csv", "md", "st", "openplc"), default="md",
+                   help="output format (default md); st: the PLC's I/O declarations in Structured Text; openplc: "
+                        "OpenPLC v3's slave-device configuration (mbconfig.cfg); both on the PLC layout")
+    _add_layout_argument(p, "the layout (default: signals; plc for --format st and openplc)")
+    g = p.add_argument_group("--format st and openplc (see docs/plc-on-real-hardware.md)")
+    g.add_argument("--program", metavar="NAME", default=None,
+                   help="st: the PROGRAM the configuration runs (default: a minimal one, `main`, comes along)")
+    g.add_argument("--task-ms", type=positive_int, default=10, help="st: the cyclic task's interval (default 10)")
+    g.add_argument("--address", default="127.0.0.1", help="openplc: the twin server's address as the PLC reaches it")
+    g.add_argument("--port", type=tcp_port, default=DEFAULT_PORT, help=f"openplc: its port (default {DEFAULT_PORT})")
+    g.add_argument("--unit-id", type=_unit, default=1, help="openplc: the slave id (default 1)")
+    g.add_argument("--polling-ms", type=positive_int, default=10, help="openplc: the polling period (default 10)")
     p.set_defaults(func=cmd_map)
     return serve
 
 
+def _add_layout_argument(p, help_text: str) -> None:
+    from .register_map import LAYOUTS
+
+    p.add_argument("--layout", choices=LAYOUTS, default=None, help=help_text)
+
+
 def add_serve_arguments(p) -> None:
     """The Modbus front end's flags of `twin serve` (and the runner's: --realtime/--lockstep, --speed)."""
+    _add_layout_argument(p, "the register map's layout: signals (the default: station signals from address 16, "
+                            "the simulator's below) or plc (for a Modbus master PLC: what it writes in one block per "
+                            "table and nothing else there, what it reads in one block without gaps, no float32)")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default: loopback only)")
     p.add_argument("--port", type=tcp_port, default=DEFAULT_PORT, help=f"TCP port (default {DEFAULT_PORT}; 0 = any free port, printed)")
     p.add_argument("--unit-id", type=_unit, default=None,
@@ -92,6 +113,10 @@ def add_serve_arguments(p) -> None:
                    help="refuse every write (functions 5, 6, 15, 16, 22, 23) with exception 01; reads are served")
     g.add_argument("--allow", type=_networks, default=None, metavar="CIDR[,CIDR...]",
                    help="accept connections only from these addresses or networks; others are closed at once")
+    g.add_argument("--poll-hold", type=nonnegative_float, default=POLL_HOLD, metavar="S",
+                   help="a client's reads are answered from the step of its first read until it reads an address "
+                        "again, writes sim.advance or reads nothing for S s (default %(default)g; 0: every read "
+                        "from the latest step)")
     g.add_argument("--gaps", choices=("error", "zero"), default="error",
                    help="reads across unmapped addresses: exception 02 (default) or zeros")
     g.add_argument("--tls-cert", metavar="PEM", help="Modbus/TCP Security: the server's certificate")
@@ -118,10 +143,26 @@ def _add_profile_arguments(p) -> None:
 
 
 def cmd_map(args) -> int:
-    from .register_map import build_map
+    from .register_map import PLC_LAYOUT, SIGNALS, build_map
 
-    rmap = build_map(args.station)
-    text = {"json": rmap.to_json, "csv": rmap.to_csv, "md": rmap.to_markdown}[args.format]()
+    for_plc = args.format in ("st", "openplc")
+    layout = args.layout or (PLC_LAYOUT if for_plc else SIGNALS)
+    if for_plc and layout != PLC_LAYOUT:
+        _log(f"error: --format {args.format} is for a Modbus master PLC: only on the plc layout (--layout plc); "
+             "the signals layout mixes what the PLC writes with what others own", logging.ERROR)
+        return 2
+    rmap = build_map(args.station, layout)
+    if args.format == "st":
+        from .plc_export import to_structured_text
+
+        text = to_structured_text(rmap, program=args.program, task_ms=args.task_ms,
+                                  serve=f"twin serve {args.station} --layout plc")
+    elif args.format == "openplc":
+        from .plc_export import to_openplc
+
+        text = to_openplc(rmap, host=args.address, port=args.port, unit_id=args.unit_id, polling_ms=args.polling_ms)
+    else:
+        text = {"json": rmap.to_json, "csv": rmap.to_csv, "md": rmap.to_markdown}[args.format]()
     sys.stdout.write(text if text.endswith("\n") else text + "\n")
     return 0
 

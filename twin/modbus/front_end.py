@@ -19,6 +19,7 @@ from twin.core.errors import StationError, TwinError
 from .bridge import TwinBridge
 from .log import log as _log
 from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT
+from .register_map import PLC_LAYOUT, POLL_HOLD
 from .server import ModbusServer
 
 
@@ -30,7 +31,7 @@ class ModbusFrontEnd:
                  max_connections: int = MAX_CONNECTIONS, idle_timeout: float = 0.0, allow=None,
                  read_only: bool = False, gaps: str = "error", watchdog: float | None = None, tls=None,
                  tls_port: int = TLS_PORT, tls_only: bool = False, profile: str | None = None,
-                 map_unit_id: int | None = None, log: Callable[..., None] = _log):
+                 map_unit_id: int | None = None, poll_hold: float = POLL_HOLD, log: Callable[..., None] = _log):
         """`unit_id`: the unit answered (default 1), with a profile the profile's (default: every unit but
         `map_unit_id`); `watchdog`: seconds (0: off; None: the station's); `tls`: an ssl.SSLContext for
         Modbus/TCP Security on `tls_port`; `profile`: a device profile (`twin.profiles.robotiq.PROFILES`)."""
@@ -39,6 +40,7 @@ class ModbusFrontEnd:
         self.allow, self.read_only, self.gaps, self.watchdog = allow, read_only, gaps, watchdog
         self.tls, self.tls_port, self.tls_only = tls, tls_port, tls_only
         self.profile_kind, self.map_unit_id, self.log = profile, map_unit_id, log
+        self.poll_hold = poll_hold
         self.bridge: TwinBridge | None = None
         self.server: ModbusServer | None = None
         self.profile = None
@@ -54,7 +56,7 @@ class ModbusFrontEnd:
                    allow=get("allow"), read_only=get("read_only", False), gaps=get("gaps", "error"),
                    watchdog=get("watchdog"), tls=tls, tls_port=get("tls_port", TLS_PORT),
                    tls_only=get("tls_only", False) or get("no_modbus", False), profile=get("profile"),
-                   map_unit_id=get("map_unit_id"))
+                   map_unit_id=get("map_unit_id"), poll_hold=get("poll_hold", POLL_HOLD))
 
     @property
     def address(self) -> tuple[str, int] | None:
@@ -91,8 +93,9 @@ class ModbusFrontEnd:
             rmap, bridge, unit_id=unit_id, frame_timeout=self.frame_timeout,
             requests_per_step=self.requests_per_step, step_period=cell.exchange.twin.dt / speed,
             max_connections=self.max_connections, idle_timeout=self.idle_timeout or None, allow=self.allow,
-            read_only=self.read_only, gaps_zero=self.gaps == "zero", identity=device_identity(cell.station, rmap),
-            on_request=on_request, log=self.log, behind=(lambda: runner.last_late) if not lockstep and runner else None)
+            read_only=self.read_only, gaps_zero=self.gaps == "zero" or rmap.layout == PLC_LAYOUT,
+            identity=device_identity(cell.station, rmap),
+            on_request=on_request, log=self.log, poll_hold=self.poll_hold, behind=(lambda: runner.last_late) if not lockstep and runner else None)
         server.on_event = getattr(getattr(cell, "events", None), "emit", None)
         lines = []
         if self.profile is not None:
@@ -112,7 +115,8 @@ class ModbusFrontEnd:
             bridge.close()
             raise OSError(f"cannot listen on {self.host}:{port}: {exc.strerror or exc}") from None
         how = "lockstep (steps on sim.advance)" if lockstep else f"real time x{speed:g}"
-        notes = [f"{len(rmap)} entries", f"unit {unit_id}", how, f"step {cell.exchange.twin.dt * 1000:g} ms"]
+        notes = [f"{len(rmap)} entries", f"{rmap.layout or 'signals'} layout", f"unit {unit_id}", how,
+                 f"step {cell.exchange.twin.dt * 1000:g} ms"]
         if self.read_only:
             notes.append("read-only")
         if watchdog is not None and watchdog.timeout:

@@ -1,8 +1,16 @@
 """The Modbus PDU codec: one request PDU in, its response PDU out. No sockets, no clock.
 
 Written from the Modbus Application Protocol specification v1.1b3: functions 1, 2, 3, 4, 5, 6, 15, 16,
-22 (mask write register, 6.16), 23 (read/write multiple registers, 6.17) and 43/14 (read device
-identification, 6.21). What each exception means here is listed in `server.py`'s docstring.
+20 (read file record, 6.14: the register map itself, see `MapFile`), 22 (mask write register, 6.16), 23
+(read/write multiple registers, 6.17) and 43/14 (read device identification, 6.21). What each exception
+means here is listed in `server.py`'s docstring.
+
+A consistent input image (`PollHold`): a master that reads its inputs in several requests (OpenPLC: discrete
+inputs, then input registers, then holding registers, the twin stepping in between) gets them all from the
+step of its first read. Each connection keeps the outputs' images (discrete inputs, input registers) of its
+first read; later reads on that connection are answered from them until one reads an address it already
+read (the next poll), asks for steps (writes `sim.advance`), or reads nothing for `POLL_HOLD` seconds (`twin
+serve --poll-hold`). Coils and holding registers are what was written, as always.
 """
 from __future__ import annotations
 
@@ -11,7 +19,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from .register_map import COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, TABLES, Entry, RegisterMap
+from .register_map import (ADVANCE, COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, POLL_HOLD, TABLES, Entry,
+                           RegisterMap)
 
 from .protocol import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
                        MAX_PDU, MAX_READ_BITS, MAX_READ_REGISTERS, MAX_RW_READ, MAX_RW_WRITE, MAX_WRITE_BITS,
@@ -126,6 +135,52 @@ class ImageLayout:
         return self.out_offset[entry.table] + entry.address, entry.count
 
 
+class PollHold:
+    """One connection's input image for its current poll (see the module docstring)."""
+
+    def __init__(self, clock, hold: float = POLL_HOLD):
+        self.clock, self.hold = clock, hold
+        self.images: Images | None = None
+        self.since = 0.0
+        self.read: list[tuple[str, int, int]] = []  # (table, start, end) read from `images`
+
+    def outputs(self, table: str, address: int, count: int, latest: Images) -> Images:
+        """The images to answer this read of an output table from (and note the read)."""
+        now, end = self.clock(), address + count
+        if (self.images is None or now - self.since > self.hold
+                or any(t == table and a < end and address < b for t, a, b in self.read)):
+            self.images, self.read = latest, []
+        self.since = now
+        self.read.append((table, address, end))
+        return self.images
+
+    def release(self) -> None:
+        self.images = None
+
+
+# -- the register map as a file (function 20, read file record) -----------------------------------------
+MAP_FILE, RECORDS_PER_FILE = 1, 10000  # the spec's record numbers are 0..9999 (0x270F) per file
+
+
+class MapFile:
+    """The map the server serves, as `twin map --format json` prints it, readable with function 20: a document
+    of 16-bit records over files 1, 2, ... (10000 records each; record r of file f is record 10000 (f - 1) + r
+    of the document): records 0-1 the map's CRC-32 (`sim.map_crc`), 2-3 the JSON's length in bytes, then the
+    UTF-8 JSON two bytes a record, the last one padded with a space. A client learns the map from the server."""
+
+    def __init__(self, rmap: RegisterMap):
+        text = rmap.to_json().encode("utf-8")
+        body = text + (b" " if len(text) % 2 else b"")
+        self.document = struct.pack(">II", rmap.crc, len(text)) + body
+        self.records = len(self.document) // 2
+
+    def read(self, file: int, record: int, length: int) -> bytes | None:
+        start = (file - MAP_FILE) * RECORDS_PER_FILE + record
+        if file < MAP_FILE or record + length > RECORDS_PER_FILE or start + length > self.records:
+            return None
+        return self.document[2 * start:2 * (start + length)]
+
+
 class Deferred:
     """A response that waits: function 23 that set sim.advance answers once the steps are done."""
 
@@ -195,10 +250,16 @@ class PduHandler:
         self.id_objects = self.identity.objects()
         self.requests = 0
         self.refused_writes = 0
+        self.held_reads = 0  # reads answered from a poll's first step while a later one was published
+        self.hold: PollHold | None = None  # the connection being answered (set by `handle`)
+        self._map_file: MapFile | None = None
 
-    def handle(self, pdu: bytes) -> bytes:
-        """One request PDU -> its response PDU (an exception: the function code | 0x80 and the code)."""
+    def handle(self, pdu: bytes, hold: PollHold | None = None) -> bytes:
+        """One request PDU -> its response PDU (an exception: the function code | 0x80 and the code).
+        `hold`: the connection's poll (a consistent input image over several reads); None answers from the
+        latest step."""
         self.requests += 1
+        self.hold = hold
         fc = pdu[0]
         try:
             handler = self._HANDLERS[fc]
@@ -232,7 +293,7 @@ class PduHandler:
         if not self.tables[table].readable(address, count):
             return ILLEGAL_DATA_ADDRESS
         images = self.backend.images
-        image = images.coils if table == COIL else images.discrete_inputs
+        image = images.coils if table == COIL else self._outputs(table, address, count).discrete_inputs
         data = pack_bits(image[address:address + count])  # gaps are 0 in the image
         return bytes((pdu[0], len(data))) + data
 
@@ -255,7 +316,7 @@ class PduHandler:
             return ILLEGAL_DATA_ADDRESS
         images = self.backend.images
         if table == INPUT_REGISTER:
-            return images.input_registers[2 * address:2 * (address + count)]
+            return self._outputs(table, address, count).input_registers[2 * address:2 * (address + count)]
         data = images.holding[2 * address:2 * (address + count)]
         patched = None
         for a in self.backend.live_addresses:
@@ -266,6 +327,16 @@ class PduHandler:
                         patched = bytearray(data)
                     struct.pack_into(">H", patched, 2 * (a - address), v)
         return data if patched is None else bytes(patched)
+
+    def _outputs(self, table: str, address: int, count: int) -> Images:
+        """The images an output read is answered from: the connection's poll's, else the latest."""
+        latest = self.backend.images
+        if self.hold is None:
+            return latest
+        images = self.hold.outputs(table, address, count, latest)
+        if images is not latest:
+            self.held_reads += 1
+        return images
 
     def _window(self, address: int, count: int):
         lay = self.layout
@@ -347,6 +418,8 @@ class PduHandler:
     # -- writes ---------------------------------------------------------------------------------------
     def _write(self, table: str, address: int, words: Sequence[int]) -> int:
         """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code."""
+        if self.hold is not None and table == HOLDING_REGISTER and self._advances(address, words):
+            self.hold.release()  # the client asked for steps: its next read is of them
         if table == HOLDING_REGISTER and address >= IMAGE_OUT:
             return self._write_window(address, words)
         t = self.tables[table]
@@ -439,11 +512,33 @@ class PduHandler:
 
     def _advances(self, address: int, words: Sequence[int]) -> bool:
         """The write sets sim.advance to a number of steps (directly, or through the output window)."""
-        adv = self.map.by_name.get("sim.advance")
+        adv = self.map.by_name.get(ADVANCE)
         if adv is None or adv.table != HOLDING_REGISTER:
             return False
         at = adv.address if address < IMAGE_OUT else IMAGE_OUT + self.layout.out_offset[HOLDING_REGISTER] + adv.address
         return address <= at < address + len(words) and words[at - address] != 0
+
+    # -- 20: read file record (6.14): the register map ---------------------------------------------------
+    def _read_file_record(self, pdu: bytes):
+        if len(pdu) < 2:
+            return ILLEGAL_DATA_VALUE
+        nbytes = pdu[1]
+        if not 0x07 <= nbytes <= 0xF5 or nbytes % 7 or len(pdu) != 2 + nbytes:
+            return ILLEGAL_DATA_VALUE
+        if self._map_file is None:
+            self._map_file = MapFile(self.map)
+        out = bytearray()
+        for k in range(2, 2 + nbytes, 7):
+            ref, file, record, length = struct.unpack_from(">BHHH", pdu, k)
+            if ref != 6 or length == 0:
+                return ILLEGAL_DATA_VALUE if length == 0 else ILLEGAL_DATA_ADDRESS
+            data = self._map_file.read(file, record, length)
+            if data is None:
+                return ILLEGAL_DATA_ADDRESS
+            out += bytes((1 + len(data), 6)) + data
+        if len(out) > MAX_PDU - 2:
+            return ILLEGAL_DATA_VALUE  # the answer would not fit one PDU
+        return bytes((20, len(out))) + bytes(out)
 
     # -- 43/14: read device identification (6.21) -----------------------------------------------------
     def _encapsulated(self, pdu: bytes):
@@ -478,5 +573,5 @@ class PduHandler:
         return bytes((MEI, MEI_DEVICE_ID, code, conformity, more, next_id, count)) + bytes(body)
 
     _HANDLERS = {1: _read_bits, 2: _read_bits, 3: _read_registers, 4: _read_registers, 5: _write_coil,
-                 6: _write_register, 15: _write_coils, 16: _write_registers, 22: _mask_write_register,
+                 6: _write_register, 15: _write_coils, 16: _write_registers, 20: _read_file_record, 22: _mask_write_register,
                  23: _read_write_registers, 43: _encapsulated}

@@ -7,7 +7,10 @@ same type from a station (`RegisterMap.from_station`, no physics) or from `twin 
 output (`RegisterMap.from_json`). A map that cannot be built or loaded raises `MapError` (a `TwinError`)
 naming the signal, or the file and the entry's index.
 
-Layout (addresses are 0-based protocol addresses):
+Two layouts (`build_register_map(..., layout)`, `twin serve --layout`): SIGNALS, the default, below; and PLC_LAYOUT
+for a Modbus master PLC (`_plc_layout`: per table the PLC's inputs alone in one block from 0, every output in one
+block without a gap, no float32; `master_ranges` gives the master's ranges). Every entry names its `owner`
+(`twin.core.signals.OWNERS`). The default layout (addresses are 0-based protocol addresses):
 
 - Every table starts with a block of `RESERVED` (16) addresses that belongs to the twin itself (the
   `sim.*` registers and the `fault` bit). Station signals start at address 16 of each table, in the
@@ -60,7 +63,7 @@ from twin.core.signal_table import (SIM_ADVANCE as ADVANCE, SIM_DT_US as DT_US, 
                                     SIM_MAP_CRC as MAP_CRC, SIM_MODE as MODE, SIM_SIGNALS, SIM_SPEED_PCT as SPEED_PCT,
                                     SIM_STEP as STEP, SIM_TIME_MS as TIME_MS, WATCHDOG_MS, station_signals)
 from twin.core.errors import TwinError
-from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec, engineering_unit
+from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, OWNERS, PLC, SignalSpec, engineering_unit
 from twin.core.station import load_station
 
 from .protocol import ADDRESSES
@@ -70,6 +73,9 @@ TABLES = (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER)
 BIT_TABLES = (COIL, DISCRETE_INPUT)
 RESERVED = 16  # addresses 0..15 of every table belong to the twin (sim.* and fault)
 MAP_UNIT_ID = 247  # the generated map's unit id while a device profile is served (twin.modbus.profile)
+SIGNALS, PLC_LAYOUT = "signals", "plc"  # the two layouts (`twin serve --layout`); SIGNALS is the default
+LAYOUTS = (SIGNALS, PLC_LAYOUT)
+PLC_TYPES = ("uint16", "int16", "int32")  # the PLC layout's analogue types: an ST UINT, INT or DINT
 
 # Conventional 1-based "Modicon" references, for the printed map.
 REFERENCE_BASE = {COIL: 1, DISCRETE_INPUT: 10001, INPUT_REGISTER: 30001, HOLDING_REGISTER: 40001}
@@ -122,6 +128,7 @@ class Entry:
     choices: tuple[str, ...] = ()  # enumerations: the value is an index into these ("" = none)
     signal: str | None = None  # the twin signal it carries (None: the twin's own sim.* entries)
     factor: float = 1.0  # SI value * factor = engineering value
+    owner: str = ""  # plc, robot, operator, simulator (`twin.core.signals.OWNERS`): who writes an input, makes an output
 
     @property
     def writable(self) -> bool:
@@ -250,6 +257,7 @@ class RegisterMap:
     station: str = ""
     source: str = field(default="", compare=False)
     meta: Mapping[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    layout: str = field(default="", compare=False)  # SIGNALS or PLC when built here; "" when loaded
     by_name: Mapping[str, Entry] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -350,7 +358,7 @@ class RegisterMap:
     def to_csv(self) -> str:
         out = io.StringIO()
         cols = ["name", "table", "address", "count", "type", "scale", "unit", "min", "max", "access",
-                "description", "choices"]
+                "description", "choices", "owner"]
         w = csv.writer(out, lineterminator="\n")
         w.writerow(cols)
         for d in self.as_list():
@@ -379,8 +387,8 @@ class RegisterMap:
             if not rows:
                 lines += ["(none)", ""]
                 continue
-            lines.append("| Addr | Ref | Name | Type | Unit | Scale | Range | Access | Description |")
-            lines.append("|---:|---:|---|---|---|---:|---|---|---|")
+            lines.append("| Addr | Ref | Name | Type | Unit | Scale | Range | Access | Owner | Description |")
+            lines.append("|---:|---:|---|---|---|---:|---|---|---|---|")
             for e in rows:
                 addr = f"{e.address}" if e.count == 1 else f"{e.address}-{e.end - 1}"
                 ref = f"{e.reference:05d}"
@@ -388,10 +396,104 @@ class RegisterMap:
                 if e.choices:
                     desc += " (" + ", ".join(f"{i} = {c or 'none'}" for i, c in enumerate(e.choices)) + ")"
                 lines.append(f"| {addr} | {ref} | `{e.name}` | {e.type} | {e.unit} | "
-                             f"{'' if e.type == 'bool' else _num(e.scale)} | {_range(e)} | {e.access} | "
+                             f"{'' if e.type == 'bool' else _num(e.scale)} | {_range(e)} | {e.access} | {e.owner} | "
                              f"{desc.replace('|', '/')} |")
             lines.append("")
+        lines += self._markdown_windows() + self._markdown_master()
         return "\n".join(lines)
+
+    def _markdown_windows(self) -> list[str]:
+        from .pdu import IMAGE_IN, IMAGE_OUT, ImageLayout
+
+        lay = ImageLayout({t: self.size(t) for t in TABLES})
+        step = self.by_name.get(STEP)
+        where = (f"; `{STEP}` is words {lay.in_words(step)[0]}-{sum(lay.in_words(step)) - 1} of it"
+                 if step is not None and step.table == INPUT_REGISTER else "")
+        return ["## Process-image windows (holding registers; one request per PLC scan)", "",
+                "| Window | Addr | Ref | Words | Holds |", "|---|---:|---:|---:|---|",
+                f"| input (read-only) | {IMAGE_IN:#06x} | {REFERENCE_BASE[HOLDING_REGISTER] + IMAGE_IN} | {lay.in_size} | "
+                f"discrete inputs packed 16 a word ({lay.in_offset[INPUT_REGISTER]} words), input registers "
+                f"({self.size(INPUT_REGISTER)}), coils packed ({lay.in_offset[HOLDING_REGISTER] - lay.in_offset[COIL]}), "
+                f"holding registers ({self.size(HOLDING_REGISTER)}): everything of one step{where} |",
+                f"| output | {IMAGE_OUT:#06x} | {REFERENCE_BASE[HOLDING_REGISTER] + IMAGE_OUT} | {lay.out_size} | "
+                f"one word per coil ({self.size(COIL)}), then the holding registers ({self.size(HOLDING_REGISTER)}) |", ""]
+
+    def _markdown_master(self) -> list[str]:
+        try:
+            ranges = master_ranges(self)
+        except MapError as exc:
+            return ["## A Modbus master PLC", "", f"Not on this layout ({exc}): serve `--layout plc` and take "
+                    "`twin map STATION --layout plc` (`--format openplc` writes its slave-device configuration).", ""]
+        lines = ["## A Modbus master PLC (its device ranges)", "",
+                 "What the PLC writes on every poll is its own and nothing else; what it reads has no gap. "
+                 "Reads of one poll (one connection, up to "
+                 f"{POLL_HOLD * 1000:g} ms) come from one step: see the Modbus README, \"A consistent input image\".", "",
+                 "| Range | Function | Start | Size | Located at (first slave device) |", "|---|---|---:|---:|---|"]
+        for r in ranges:
+            lines.append(f"| {r.title} | {r.function} | {r.start} | {r.size} | {r.located or '-'} |")
+        return lines + [""]
+
+
+POLL_HOLD = 0.1  # s: reads of one connection within this long of its first come from one step (twin.modbus.pdu)
+
+
+@dataclass(frozen=True)
+class MasterRange:
+    """One of a Modbus master's device ranges (OpenPLC's slave-device form), on the PLC layout."""
+
+    key: str  # OpenPLC's mbconfig.cfg key: Discrete_Inputs, Coils, Input_Registers, Holding_Registers_Read, Holding_Registers
+    title: str
+    function: str
+    table: str
+    start: int
+    size: int
+    located: str  # where the first slave device's range lands in the PLC (OpenPLC's convention)
+    entries: tuple[Entry, ...]
+
+
+def master_ranges(rmap: "RegisterMap") -> tuple[MasterRange, ...]:
+    """The ranges a Modbus master PLC is configured with, in its order (discrete inputs, coils, input registers,
+    holding registers read, holding registers written): all it reads (whole tables, no gap), exactly what the
+    PLC owns to write. MapError when the map is not laid out for it (the default layout mixes owners)."""
+    def block(table: str, entries) -> tuple[int, int]:
+        entries = sorted(entries, key=lambda e: e.address)
+        if not entries:
+            return 0, 0
+        start, end = entries[0].address, entries[-1].end
+        covered = sum(e.count for e in entries)
+        if covered != end - start:
+            raise MapError(f"the {table}s a PLC {'writes' if table in (COIL, HOLDING_REGISTER) else 'reads'} are not one "
+                           f"block ({start}..{end - 1} has gaps or others' entries)")
+        return start, end - start
+
+    ranges, counted = [], {"IX": 0, "IW": 0}
+    specs = (("Discrete_Inputs", "Discrete inputs (read)", "FC 2", DISCRETE_INPUT, "IX"),
+             ("Coils", "Coils (written)", "FC 15", COIL, "QX"),
+             ("Input_Registers", "Input registers (read)", "FC 4", INPUT_REGISTER, "IW"),
+             ("Holding_Registers_Read", "Holding registers (read)", "FC 3", HOLDING_REGISTER, "IW"),
+             ("Holding_Registers", "Holding registers (written)", "FC 16", HOLDING_REGISTER, "QW"))
+    for key, title, fc, table, area in specs:
+        if key == "Holding_Registers_Read":
+            chosen = ()  # the PLC reads back nothing it wrote: its own setpoints are in its own memory
+        elif table in (COIL, HOLDING_REGISTER):
+            chosen = tuple(e for e in rmap.table(table) if e.writable and e.owner == PLC)
+        else:
+            chosen = rmap.table(table)
+        start, size = block(table, chosen)
+        if table in (DISCRETE_INPUT, INPUT_REGISTER) and size and (start != 0 or size != rmap.size(table)):
+            raise MapError(f"the {table}s do not start at 0 without a gap")
+        if table in (COIL, HOLDING_REGISTER) and chosen and start != 0:
+            raise MapError(f"the PLC's {table}s do not start at 0")
+        if table == DISCRETE_INPUT and any(a not in rmap.mapped[table] for a in range(start, start + size)):
+            raise MapError(f"the {table}s have gaps")
+        first = counted.get(area, 0)
+        located = ""
+        if size:
+            located = f"%{area}{100 + first // 8}.{first % 8}" if area.endswith("X") else f"%{area}{100 + first}"
+        if area in counted:
+            counted[area] = first + size
+        ranges.append(MasterRange(key, title, fc, table, start, size, located, chosen))
+    return tuple(ranges)
 
 
 def _entry_from_dict(e: Any, where: str, i: int) -> Entry:
@@ -417,7 +519,8 @@ def _entry_from_dict(e: Any, where: str, i: int) -> Entry:
                       min=None if e.get("min") is None else float(e["min"]),
                       max=None if e.get("max") is None else float(e["max"]),
                       access=str(e.get("access") or ("rw" if table in (COIL, HOLDING_REGISTER) else "r")),
-                      description=str(e.get("description") or ""), choices=tuple(str(c) for c in e.get("choices") or ()))
+                      description=str(e.get("description") or ""), choices=tuple(str(c) for c in e.get("choices") or ()),
+                      owner=str(e.get("owner") or ""))
     except (TypeError, ValueError) as exc:
         if isinstance(exc, MapError):
             raise
@@ -431,6 +534,8 @@ def _entry_from_dict(e: Any, where: str, i: int) -> Entry:
         raise bad(f"access {entry.access!r}: 'r', or 'rw' in the coils and holding registers")
     if not entry.scale > 0:
         raise bad(f"scale {entry.scale:g} must be greater than 0")
+    if entry.owner and entry.owner not in OWNERS:
+        raise bad(f"owner {entry.owner!r}: one of {', '.join(OWNERS)}")
     if entry.min is not None and entry.max is not None and entry.min > entry.max:
         raise bad(f"min {entry.min:g} is above max {entry.max:g}")
     return entry
@@ -470,6 +575,8 @@ SIM_PLACES = {
     DT_US: (INPUT_REGISTER, 6, "uint16"), MODE: (INPUT_REGISTER, 7, "uint16"), SPEED_PCT: (INPUT_REGISTER, 8, "uint16"),
     MAP_CRC: (INPUT_REGISTER, 10, "uint32"), WATCHDOG_MS: (INPUT_REGISTER, 12, "uint32"),
 }
+# The PLC layout: the simulator's outputs lead what a PLC reads, in this order (sim.step at input registers 0-1).
+PLC_SIM_FIRST = tuple(s.name for s in SIM_SIGNALS if s.direction != INPUT)
 # What the protocol adds to a sim signal's description (the Modbus answer to a refused write).
 SIM_NOTES = {ADVANCE: " (else exception 03)", FAULT: ", writes get exception 04"}
 
@@ -478,16 +585,23 @@ def _sim_entries() -> list[Entry]:
     entries = []
     for s in SIM_SIGNALS:
         table, address, type_ = SIM_PLACES[s.name]
-        entries.append(Entry(s.name, table, address, WIDTH[type_], type_, 1.0, s.unit, s.min, s.max,
-                             "rw" if s.direction == INPUT else "r", s.description + SIM_NOTES.get(s.name, "")))
+        entries.append(_sim_entry(s, table, address, type_))
     return entries
 
 
-def _fit_type(lo_e: float | None, hi_e: float | None, scale: float, signed_default: bool) -> str:
+def _sim_entry(s: SignalSpec, table: str, address: int, type_: str) -> Entry:
+    return Entry(s.name, table, address, WIDTH[type_], type_, 1.0, s.unit, s.min, s.max,
+                 "rw" if s.direction == INPUT else "r", s.description + SIM_NOTES.get(s.name, ""), owner=s.owned_by)
+
+
+def _fit_type(lo_e: float | None, hi_e: float | None, scale: float, signed_default: bool,
+              types: tuple[str, ...] = ("uint16", "int16", "uint32", "int32")) -> str:
     if lo_e is None or hi_e is None:
+        if "uint32" not in types:
+            return "int32"
         return "int32" if (lo_e is None or lo_e < 0 or signed_default) else "uint32"
     lo, hi = math.ceil(lo_e / scale - 1e-6), math.floor(hi_e / scale + 1e-6)
-    for t in ("uint16", "int16", "uint32", "int32"):
+    for t in types:
         tlo, thi = TYPE_LIMITS[t]
         if tlo <= lo and hi <= thi:
             return t
@@ -498,28 +612,49 @@ def _eng(v: float | None, factor: float) -> float | None:
     return None if v is None else round(v * factor, 9)
 
 
-def _signal_entry(s: SignalSpec, table: str, address: int) -> Entry:
+def _signal_entry(s: SignalSpec, table: str, address: int, layout: str = SIGNALS) -> Entry:
     access = "rw" if s.direction == INPUT else "r"
-    common = dict(name=s.name, table=table, address=address, access=access, description=s.description, signal=s.name)
+    common = dict(name=s.name, table=table, address=address, access=access, description=s.description, signal=s.name,
+                  owner=s.owned_by)
     if table in BIT_TABLES:
         return Entry(count=1, type="bool", scale=1.0, unit="", min=None, max=None, **common)
     if s.type == ENUM:
         return Entry(count=1, type="uint16", scale=1.0, unit="", min=0, max=max(0, len(s.choices) - 1),
                      choices=tuple(s.choices), **common)
+    types = PLC_TYPES if layout == PLC_LAYOUT else ("uint16", "int16", "uint32", "int32")
     if s.type == INT:
-        t = _fit_type(s.min, s.max, 1.0, False)
+        t = _fit_type(s.min, s.max, 1.0, False, types)
+        if t == "float32":
+            raise MapError(f"signal {s.name!r}: its range {s.min:g} .. {s.max:g} does not fit a 32-bit integer")
         return Entry(count=WIDTH[t], type=t, scale=1.0, unit=s.unit, min=s.min, max=s.max, **common)
-    if s.unit in UNITS:
-        unit, factor, scale = UNITS[s.unit]
+    if s.unit in UNITS or layout == PLC_LAYOUT:  # the PLC layout has no float32: every float in counts of 0.01
+        unit, factor, scale = UNITS.get(s.unit) or (*engineering_unit(s.unit), 0.01)
         lo, hi = _eng(s.min, factor), _eng(s.max, factor)
-        t = _fit_type(lo, hi, scale, False)
+        t = _fit_type(lo, hi, scale, False, types)
         if t != "float32":
             return Entry(count=WIDTH[t], type=t, scale=scale, unit=unit, min=lo, max=hi, factor=factor, **common)
+        if layout == PLC_LAYOUT:
+            raise MapError(f"signal {s.name!r}: its range {lo:g} .. {hi:g} {unit} in counts of {scale:g} does not fit "
+                           "a DINT (the PLC layout has no float32)")
     return Entry(count=2, type="float32", scale=1.0, unit=s.unit, min=s.min, max=s.max, **common)
 
 
-def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> RegisterMap:
-    """The register map of a signal table (see the module docstring for the layout)."""
+def _table_of(s: SignalSpec) -> str | None:
+    """Where a signal goes: bools in the bit tables, numbers in the registers; inputs writable, outputs not."""
+    if s.type == BOOL:
+        return COIL if s.direction == INPUT else DISCRETE_INPUT
+    if s.type in (FLOAT, INT, ENUM):
+        return HOLDING_REGISTER if s.direction == INPUT else INPUT_REGISTER
+    return None  # text and other types are not served (none exist yet)
+
+
+def build_register_map(signals: Iterable[SignalSpec], station: str = "", layout: str = "") -> RegisterMap:
+    """The register map of a signal table (see the module docstring for the two layouts; default SIGNALS)."""
+    layout = layout or SIGNALS
+    if layout not in LAYOUTS:
+        raise MapError(f"unknown register map layout {layout!r} (one of {', '.join(LAYOUTS)})")
+    if layout == PLC_LAYOUT:
+        return _plc_layout(signals, station)
     entries = _sim_entries()
     seen = {e.name for e in entries}
     nxt = {t: RESERVED for t in TABLES}
@@ -529,11 +664,8 @@ def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> Regi
         if s.name in seen:
             raise MapError(f"signal {s.name!r} appears twice (or clashes with the simulator's own entry)")
         seen.add(s.name)
-        if s.type == BOOL:
-            table = COIL if s.direction == INPUT else DISCRETE_INPUT
-        elif s.type in (FLOAT, INT, ENUM):
-            table = HOLDING_REGISTER if s.direction == INPUT else INPUT_REGISTER
-        else:  # text and other types are not served (none exist yet)
+        table = _table_of(s)
+        if table is None:
             continue
         e = _signal_entry(s, table, nxt[table])
         nxt[table] = e.end
@@ -542,11 +674,45 @@ def build_register_map(signals: Iterable[SignalSpec], station: str = "") -> Regi
         entries.append(e)
     order = {t: i for i, t in enumerate(TABLES)}
     entries.sort(key=lambda e: (order[e.table], e.address))
-    return RegisterMap(tuple(entries), station)
+    return RegisterMap(tuple(entries), station, layout=SIGNALS)
 
 
-def build_map(station) -> RegisterMap:
+def _plc_layout(signals: Iterable[SignalSpec], station: str) -> RegisterMap:
+    """The PLC layout: per table, the PLC's inputs first and alone in one block from address 0 (what a Modbus
+    master writes on every poll), the others' inputs after it; every output in one block from 0 without a
+    gap (what it reads), the simulator's first (`sim.step` at input registers 0-1); no float32."""
+    sims = {s.name: s for s in SIM_SIGNALS}
+    station_specs, seen = [], set(sims)
+    for s in signals:
+        if s.name in sims:
+            continue
+        if s.name in seen:
+            raise MapError(f"signal {s.name!r} appears twice (or clashes with the simulator's own entry)")
+        seen.add(s.name)
+        if _table_of(s) is not None:
+            station_specs.append(s)
+    first = [sims[n] for n in PLC_SIM_FIRST]  # the simulator's outputs, at the start of what a PLC reads
+    ordered = ([s for s in station_specs if s.direction == INPUT and s.owned_by == PLC]
+               + first + [s for s in station_specs if not (s.direction == INPUT and s.owned_by == PLC)]
+               + [sims[n] for n in sims if n not in PLC_SIM_FIRST])
+    entries, nxt = [], {t: 0 for t in TABLES}
+    for s in ordered:
+        table = _table_of(s)
+        if s.name in sims:
+            e = _sim_entry(s, table, nxt[table], SIM_PLACES[s.name][2])
+        else:
+            e = _signal_entry(s, table, nxt[table], PLC_LAYOUT)
+        if e.end > ADDRESSES:
+            raise MapError(f"signal {s.name!r}: the {table} table is full ({ADDRESSES} addresses)")
+        nxt[table] = e.end
+        entries.append(e)
+    order = {t: i for i, t in enumerate(TABLES)}
+    entries.sort(key=lambda e: (order[e.table], e.address))
+    return RegisterMap(tuple(entries), station, layout=PLC_LAYOUT)
+
+
+def build_map(station, layout: str = "") -> RegisterMap:
     """The map `twin serve` serves for a station (a folder or a station.toml), from its static signal table:
     no physics, no RAPID (a wrong station raises the core's StationError)."""
     st = load_station(station)
-    return build_register_map(station_signals(st), st.name)
+    return build_register_map(station_signals(st), st.name, layout)

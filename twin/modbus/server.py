@@ -79,9 +79,9 @@ from twin.core.defaults import DEFAULT_STEP
 
 from .log import log as _log
 from .pdu import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
-                  SERVER_DEVICE_FAILURE, Backend, Deferred, DeviceIdentity, Images, PduHandler)
+                  SERVER_DEVICE_FAILURE, Backend, Deferred, DeviceIdentity, Images, PduHandler, PollHold)
 from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT  # noqa: F401
-from .register_map import RegisterMap
+from .register_map import POLL_HOLD, RegisterMap
 
 MAX_LENGTH = 1 + 10 + 2 * 127  # MBAP length: unit id + function 23 writing 127 registers (byte count 254)
 SERVE_SHARE = 0.5  # at most this share of a step period's wall time goes to answering requests
@@ -130,7 +130,8 @@ class ModbusServer:
                  idle_timeout: float | None = None, allow: Iterable | None = None, read_only: bool = False,
                  gaps_zero: bool = False, identity: DeviceIdentity | None = None,
                  on_request: Callable[[str, bool], None] | None = None, behind: Callable[[], bool] | None = None,
-                 log: Callable[[str], None] = _log, clock: Callable[[], float] = time.perf_counter):
+                 log: Callable[[str], None] = _log, clock: Callable[[], float] = time.perf_counter,
+                 poll_hold: float = POLL_HOLD):
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
         self.units = {unit_id, 0, 255}
         self.pdus = PduHandler(rmap, backend, read_only=read_only, gaps_zero=gaps_zero, identity=identity)
@@ -142,7 +143,7 @@ class ModbusServer:
         self.on_request = on_request
         self.behind = behind  # the simulation is late: answer less until it has caught up
         self.scale = 1.0  # the share of the budget in force (halved per late period, regrown when on time)
-        self.log, self.clock = log, clock
+        self.log, self.clock, self.poll_hold = log, clock, poll_hold
         self.on_event: Callable[..., None] | None = None  # `twin.events.Events.emit`: clients come and go
         self.connections: set[_Connection] = set()
         self._servers: list[asyncio.base_events.Server] = []
@@ -227,15 +228,15 @@ class ModbusServer:
         self._sweeper = loop.call_later(min(1.0, self.idle_timeout / 4), self._sweep)
 
     # -- requests -----------------------------------------------------------------------------------
-    def handle(self, unit: int, pdu: bytes) -> bytes:
-        """One request PDU -> its response PDU."""
+    def handle(self, unit: int, pdu: bytes, hold: PollHold | None = None) -> bytes:
+        """One request PDU -> its response PDU (`hold`: the connection's poll, see `pdu.PollHold`)."""
         if unit not in self.units:
             other = self.route(unit) if self.route is not None else None
             if other is not None:
                 return other.handle(pdu)
             self.pdus.requests += 1
             return bytes((pdu[0] | 0x80, GATEWAY_TARGET_FAILED))
-        return self.pdus.handle(pdu)
+        return self.pdus.handle(pdu, hold)
 
     # -- the fair share ------------------------------------------------------------------------------
     def want_turn(self, conn: "_Connection", fresh: bool) -> None:
@@ -320,6 +321,7 @@ class _Connection(asyncio.Protocol):
         self.address = ""
         self.reason = ""
         self.last_request = 0.0
+        self.hold = PollHold(server.clock, server.poll_hold)  # this client's poll: one step's outputs
 
     def connection_made(self, transport) -> None:
         self.transport = transport
@@ -462,7 +464,7 @@ class _Connection(asyncio.Protocol):
             request = bytes(buf[pos + 7:pos + 6 + length])
             if self.clock_only and not clock(request):
                 self.clock_only = False
-            response = handle(unit, request)
+            response = handle(unit, request, self.hold)
             pos += 6 + length
             count += 1
             if isinstance(response, Deferred):  # answered once the lockstep steps are done; later ones wait
