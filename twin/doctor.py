@@ -457,6 +457,8 @@ class Doctor:
         if not st.targets:
             self.check(FAIL, "station", "grip", "targets", "the station has no target to grip")
             return self.report
+        if not self.twin.read("Active"):
+            self.twin.write("Active", True)  # a gripper that is not always active follows its setpoints once told to
         self.rest()
         drive_of = {f: self.reach.closing_drive(f) for f in self.fingers}
         for d in sorted({d for d in drive_of.values() if d is not None}, key=list(self.g.joint).index):

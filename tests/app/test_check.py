@@ -78,7 +78,8 @@ DENSITY = 7850.0
 PART_FRICTION, FINGER_FRICTION = 0.5, 0.8
 
 
-def newcomer_station(folder, effort: float, part_y: float = 0.0, extra: str = "") -> tuple:
+def newcomer_station(folder, effort: float, extra: str = ""):
+    """The gripper fixed above a steel block on the floor; not `always_active`, as a newcomer leaves it."""
     folder.mkdir()
     two_finger_urdf(folder / "gripper.urdf", effort)
     sx, sy, sz = BLOCK
@@ -89,7 +90,6 @@ name = "newcomer"
 [gripper]
 urdf = "gripper.urdf"
 mount = {{ xyz = [0.0, 0.0, {sz + 0.015}], rpy_deg = [180.0, 0.0, 0.0] }}
-always_active = true
 friction = {FINGER_FRICTION}
 initial = {{ jaw_a = 0.035, jaw_b = 0.035 }}
 {extra}
@@ -98,7 +98,7 @@ initial = {{ jaw_a = 0.035, jaw_b = 0.035 }}
 name = "block"
 shape = "box"
 size = [{sx}, {sy}, {sz}]
-xyz = [0.0, {part_y}, {sz / 2}]
+xyz = [0.0, 0.0, {sz / 2}]
 density = {DENSITY}
 friction = {PART_FRICTION}
 
