@@ -9,6 +9,8 @@ import re
 import subprocess
 import sys
 
+import pytest
+
 from modbus_helpers import ROOT
 from twin.modbus.plc_export import RESERVED, st_name
 from twin.modbus.register_map import COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, build_map
@@ -114,3 +116,66 @@ def test_the_st_formats_refuse_the_signals_layout():
     out = subprocess.run([sys.executable, "-m", "twin", "map", str(CELL), "--format", "st", "--layout", "signals"],
                          cwd=ROOT, capture_output=True, text=True)
     assert out.returncode == 2 and "--layout plc" in out.stderr
+
+
+def test_a_located_variable_the_master_does_not_serve_or_whose_type_cannot_hold_its_register_is_named():
+    from twin.modbus.plc_export import located_problem
+
+    rmap, cfg = build_map(CELL, "plc"), ranges()
+    last_di = cfg["Discrete_Inputs_Size"] - 1
+    ok = [("I", "X", (100 + last_di // 8, last_di % 8), "BOOL"), ("Q", "W", (100 + rmap["L2"].address,), "UINT"),
+          ("Q", "W", (100 + rmap["L5"].address,), "INT"),  # 0 .. 10 mm is 0 .. 1000 counts: an INT holds it
+          ("M", "W", (7,), "REAL")]  # memory is not the master's business
+    for loc in ok:
+        assert located_problem(rmap, *loc) is None, loc
+    past = cfg["Discrete_Inputs_Size"]
+    bad = {("I", "X", (100 + past // 8, past % 8), "BOOL"): "no signal there",  # one past the last discrete input
+           ("Q", "X", (100, cfg["Coils_Size"]), "BOOL"): "no signal there",  # the operator's coils are not the PLC's
+           ("Q", "W", (100 + rmap["L2"].address,), "INT"): "L2",  # 44100 counts above an INT
+           ("I", "W", (100 + rmap["L2.actual"].address,), "REAL"): "L2.actual",  # a float on a 16-bit register
+           ("I", "D", (100,), "DINT"): "two %IW words",  # a master has no 32-bit locations
+           ("I", "X", (100, 0), "INT"): "fault"}
+    for loc, named in bad.items():
+        problem = located_problem(rmap, *loc)
+        assert problem is not None and named in problem, (loc, problem)
+    assert "44100" in located_problem(rmap, "Q", "W", (100 + rmap["L2"].address,), "INT")
+
+
+def _plc(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "plc_client", *args], cwd=ROOT, capture_output=True, text=True)
+
+
+@pytest.mark.skipif(not (ROOT / "structured_text" / "checker.py").exists(), reason="the ST runtime has not landed")
+def test_the_declarations_pass_plc_check_alone_and_with_a_program_that_uses_them(tmp_path):
+    alone = tmp_path / "io.st"
+    alone.write_text(twin_map("--format", "st"))
+    out = _plc("check", str(alone))
+    assert out.returncode == 0, out.stderr
+    (tmp_path / "io.st").write_text(twin_map("--format", "st", "--program", "gripper"))
+    (tmp_path / "gripper.st").write_text(GRIPPER)
+    out = _plc("check", str(tmp_path / "gripper.st"), str(tmp_path / "io.st"))
+    assert out.returncode == 0, out.stderr
+
+
+GRIPPER = """PROGRAM gripper
+  VAR_EXTERNAL
+    doPrepare : BOOL;
+    diGripDone : BOOL;
+    L2 : UINT;
+    L2_actual : UINT;
+    L2_force_HI : INT;
+    L2_force_LO : UINT;
+  END_VAR
+  VAR_EXTERNAL CONSTANT
+    COUNTS_PER_N : DINT;
+  END_VAR
+  VAR
+    force : DINT;
+  END_VAR
+  force := INT_TO_DINT(L2_force_HI) * 65536 + UINT_TO_DINT(L2_force_LO);
+  IF doPrepare THEN
+    L2 := L2_actual;
+  END_IF;
+  diGripDone := force > 100 * COUNTS_PER_N;
+END_PROGRAM
+"""

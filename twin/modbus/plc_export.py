@@ -103,6 +103,67 @@ def located_variables(rmap: RegisterMap) -> list[Located]:
     return out
 
 
+# What each ST type holds, for a located variable over a register (ST elementary integer and bit-string types).
+ST_RANGES = {"SINT": (-128, 127), "USINT": (0, 255), "BYTE": (0, 255), "INT": (-32768, 32767), "UINT": (0, 65535),
+             "WORD": (0, 65535)}
+_WHERE = {"IX": "discrete inputs", "QX": "coils", "IW": "input registers (then holding registers read)",
+          "QW": "holding registers written"}
+
+
+def located_problem(rmap: RegisterMap, area: str, size: str, indexes: tuple[int, ...], st_type: str) -> str | None:
+    """Why a located variable `%<area><size><indexes>` of type `st_type` does not fit what a Modbus master reads
+    and writes on this map (the device ranges of `master_ranges`, OpenPLC's convention), naming the signal; None
+    when it fits, and for memory (`%M`). The ST checker's hook to the map: `plc check` reports the message at the
+    variable's position. A located variable outside the ranges, a bit at a word, a 32-bit location (a master has
+    none), or a type that cannot hold the register's values (REAL on a 16-bit register; INT on a uint16 above
+    32767 counts) is a problem."""
+    area, size, st_type = area.upper(), (size or "X").upper(), st_type.upper()
+    if area not in ("I", "Q"):
+        return None
+    at = f"%{area}{size}" + ".".join(str(i) for i in indexes)
+    if size not in ("X", "W"):
+        return (f"{at}: a Modbus master's slave device gives bits (%{area}X) and 16-bit registers (%{area}W) only; "
+                f"a 32-bit value is two %{area}W words, NAME_HI and NAME_LO (`twin map --format st`)")
+    variables = located_variables(rmap)
+    found = next((v for v in variables if v.address == at), None)
+    if found is None:
+        same = [v.address for v in variables if v.address.startswith(f"%{area}{size}")]
+        span = f"{same[0]} .. {same[-1]}" if same else "none"
+        return (f"{at}: no signal there: the device's {_WHERE[area + size]} on this map are {span} "
+                f"(`twin map --format st` declares every one)")
+    e = found.entry
+    what = f"{e.name} ({_where(e)} {e.address}{'' if e.count == 1 else f'-{e.end - 1}'}, {e.type})"
+    if size == "X":
+        return None if st_type == "BOOL" else f"{at} is {what}: a bit, declare it BOOL, not {st_type}"
+    if st_type not in ST_RANGES:
+        return (f"{at} is {what}: a 16-bit register cannot be a {st_type}"
+                + ("; a 32-bit value is two words, NAME_HI and NAME_LO" if e.count == 2 else "")
+                + f" (declare it {found.st_type})")
+    lo, hi = _word_range(e, found.word)
+    tlo, thi = ST_RANGES[st_type]
+    if st_type != "WORD" and not (tlo <= lo and hi <= thi):
+        which = {"HI": "its high word carries ", "LO": "its low word carries "}.get(found.word, "")
+        return (f"{at} is {what}: {which}{lo} .. {hi}, a{'n' if st_type[0] in 'AEIOU' and st_type != 'UINT' else ''} "
+                f"{st_type} holds {tlo} .. {thi} (declare it {found.st_type})")
+    return None
+
+
+def _where(e: Entry) -> str:
+    return {COIL: "coil", DISCRETE_INPUT: "discrete input", INPUT_REGISTER: "input register",
+            HOLDING_REGISTER: "holding register"}[e.table]
+
+
+def _word_range(e: Entry, word: str) -> tuple[int, int]:
+    """The values a register (or one word of a 32-bit value) carries, as a 16-bit integer."""
+    if word == "LO":
+        return 0, 0xFFFF
+    lo, hi = e.count_range
+    if word == "HI":
+        lo, hi = int(lo) >> 16, int(hi) >> 16  # the high word of a 32-bit value, sign included
+        return lo, hi
+    return int(lo), int(hi)
+
+
 def _comment(text: str) -> str:
     return "(* " + text.replace("(*", "( *").replace("*)", "* )") + " *)"
 
@@ -226,4 +287,5 @@ def to_openplc(rmap: RegisterMap, *, host: str = "127.0.0.1", port: int = 5020, 
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["st_name", "located_variables", "to_structured_text", "to_openplc", "RESERVED", "MAP_CRC"]
+__all__ = ["st_name", "located_variables", "located_problem", "to_structured_text", "to_openplc", "RESERVED",
+           "MAP_CRC"]
