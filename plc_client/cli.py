@@ -8,6 +8,10 @@
                                           sim.advance goes last, after the other writes are answered
         watch NAME... [--interval S] [--count N]   a live view (one redrawn line on a terminal)
         run MODULE:NAME [--cycle S] [--seconds S | --scans N] [--speed X]   run PLC logic on a scan cycle
+    plc check FILE.st...                  check Structured Text (IEC 61131-3): FILE:LINE:COL errors, exit 65
+    plc run FILE.st... --offline --for S [--cycle MS] [--set NAME=VALUE[@T]] [--watch NAMES] --trace
+                                          run Structured Text offline in simulated time (docs/plc-st.md);
+                                          here --cycle is in milliseconds
         map                               the signals it knows: table, address, type, unit, range, access
         run [--station DIR]               the PLC logic the station names ([plugins] plc_logic)
     plc demo [--station DIR] [OPTIONS]    a station's demo ([plugins] plc_demo in its station.toml; without
@@ -98,6 +102,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="do not print the outputs' changes")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_run)
+    p = sub.add_parser("check", help="check Structured Text files (FILE.st ...): one FILE:LINE:COL line per error, exit 65")
+    p.add_argument("files", nargs="+", metavar="FILE.st")
+    p.set_defaults(func=cmd_check)
     p = sub.add_parser("map", help="the signals the map knows: table, address, type, unit, range, access")
     _globals(p, suppress=True)
     p.set_defaults(func=cmd_map)
@@ -325,6 +332,23 @@ def cmd_run(args) -> int:
     return 0
 
 
+def cmd_check(args) -> int:
+    from structured_text.cli import check_main
+    return check_main(args.files)
+
+
+def structured_text_command(argv: list[str]) -> list[str] | None:
+    """`plc [globals] run FILE.st ...` or `plc check ...`: the Structured Text runtime's own command line
+    (its --cycle is in milliseconds, as IEC tools give task intervals), else None."""
+    for i, a in enumerate(argv):
+        if a in ("run", "check"):
+            rest = argv[i + 1:]
+            if a == "check" or any(r.lower().endswith(".st") for r in rest if not r.startswith("-")):
+                return [a] + rest
+            return None
+    return None
+
+
 def cmd_map(args) -> int:
     rmap = load_map(args)
     rows = [("name", "table", "address", "type", "unit", "range", "access")]
@@ -379,6 +403,11 @@ class UsageError(PlcClientError):
 def main(argv: list[str] | None = None) -> int:
     from twin.plugins import parse_command_line
 
+    argv = sys.argv[1:] if argv is None else argv
+    st = structured_text_command(argv)
+    if st is not None and not (len(st) == 2 and st[1] in ("-h", "--help") and st[0] == "run"):
+        from structured_text.cli import check_main, run_main
+        return (check_main if st[0] == "check" else run_main)(st[1:])
     args = parse_command_line(build_parser(), argv)  # a station's demo keeps its own options
     logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # its own log lines would repeat ours
     try:

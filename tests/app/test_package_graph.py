@@ -1,5 +1,5 @@
 """The package graph runs one way: `twin.core` at the bottom, the controller (`rapid_like`) and the front ends
-above it, the application (`twin_app`) on top. Built from the source (ast, imports inside functions too)."""
+above it (the Structured Text runtime `structured_text` beside `rapid_like`), the application (`twin_app`) on top. Built from the source (ast, imports inside functions too)."""
 from __future__ import annotations
 
 import ast
@@ -7,7 +7,7 @@ from pathlib import Path
 
 from tests.conftest import ROOT
 
-PACKAGES = ("twin", "twin_app", "rapid_like", "plc_client", "stations", "bench")
+PACKAGES = ("twin", "twin_app", "rapid_like", "structured_text", "plc_client", "stations", "bench")
 # A package's `__main__.py` is a launcher (like a console script): it belongs to the application layer.
 LAUNCHER_LAYER = "twin_app"
 
@@ -110,7 +110,16 @@ def test_the_core_imports_nothing_above_it():
 
 def test_front_ends_and_the_controller_do_not_import_the_application():
     bad = [f"{path.relative_to(ROOT)} imports {target}"
-           for pkg in ("twin", "rapid_like", "plc_client") for path in sorted((ROOT / pkg).rglob("*.py"))
+           for pkg in ("twin", "rapid_like", "structured_text", "plc_client") for path in sorted((ROOT / pkg).rglob("*.py"))
            if path.name != "__main__.py"
            for target in imports_of(path) if target.split(".")[0] == "twin_app"]
     assert not bad, "; ".join(bad)
+
+
+def test_the_structured_text_runtime_sits_beside_the_rapid_interpreter():
+    """structured_text may use twin.core only; the PLC client may use it, never the other way round."""
+    edges = package_edges()
+    assert set(edges.get("structured_text", {})) <= {"twin"}, edges.get("structured_text")
+    assert not any(p.startswith("twin.") and not p.startswith("twin.core") for e in edges.get("structured_text", {}).values()
+                   for p in [x.split(" -> ")[1] for x in e])
+    assert "structured_text" in edges["plc_client"]  # `plc check` / `plc run FILE.st`

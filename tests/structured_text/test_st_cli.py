@@ -1,0 +1,87 @@
+"""`plc check` and `plc run FILE.st --offline --trace` end to end, through the real command (a subprocess)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+from tests.conftest import ROOT
+
+
+def plc(*args, cwd=None):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-m", "plc_client", *args], capture_output=True, text=True,
+                          env=env, cwd=cwd, timeout=60)
+
+
+def write(tmp_path, name, text):
+    p = tmp_path / name
+    p.write_text(text)
+    return str(p)
+
+
+def trace(stdout: str):
+    return [json.loads(line) for line in stdout.splitlines()]
+
+
+def test_check_exit_codes_and_error_lines(tmp_path):
+    good = write(tmp_path, "good.st", "PROGRAM p\nVAR c : INT; END_VAR\nc := c + 1;\nEND_PROGRAM\n")
+    bad = write(tmp_path, "bad.st", "PROGRAM p\nVAR c : INT; END_VAR\nc := d + 1;\nc := TRUE;\nEND_PROGRAM\n")
+    r = plc("check", good)
+    assert r.returncode == 0, r.stderr
+    r = plc("check", bad)
+    assert r.returncode == 65
+    assert r.stderr.splitlines() == [f"{bad}:3:6: error: 'd' is not declared",
+                                     f"{bad}:4:6: error: type mismatch in the assignment: a BOOL cannot be stored in an INT "
+                                     "(convert it: BOOL_TO_INT)"]
+
+
+def test_run_traces_a_counter_and_a_ton_by_the_standards_timing(tmp_path):
+    # TON with PT = 30 ms, IN TRUE from t = 0 on a 10 ms cycle: ET 0, 10, 20, 30 ms; Q rises at t = 30 ms.
+    src = write(tmp_path, "ton.st", """
+PROGRAM main
+VAR
+  cnt : INT := 32766;
+  t1 : TON;
+  go : BOOL;
+END_VAR
+t1(IN := go, PT := T#30ms);
+cnt := cnt + 1;
+END_PROGRAM
+""")
+    r = plc("run", src, "--offline", "--for", "0.06", "--set", "go=TRUE@0.01", "--watch", "cnt,t1.Q,t1.ET", "--trace")
+    assert r.returncode == 0, r.stderr
+    lines = trace(r.stdout)
+    assert lines[:3] == [{"t": 0.0, "scan": 0, "name": "cnt", "value": 32767},
+                         {"t": 0.0, "scan": 0, "name": "t1.Q", "value": False},
+                         {"t": 0.0, "scan": 0, "name": "t1.ET", "value": 0}]
+    cnt = [(x["scan"], x["value"]) for x in lines if x["name"] == "cnt"]
+    assert cnt[:3] == [(0, 32767), (1, -32768), (2, -32767)]  # INT wraps
+    q = [(x["t"], x["value"]) for x in lines if x["name"] == "t1.Q"]
+    assert q == [(0.0, False), (0.04, True)]  # IN rose at 0.01; 0.01 + 30 ms
+    et = [(x["t"], x["value"]) for x in lines if x["name"] == "t1.ET"]
+    assert et == [(0.0, 0), (0.02, 10), (0.03, 20), (0.04, 30)]
+    assert max(x["scan"] for x in lines) == 5  # --for 0.06: scans at 0 .. 50 ms
+
+
+def test_runtime_error_stops_with_place_and_task(tmp_path):
+    src = write(tmp_path, "div.st", "PROGRAM main\nVAR a : INT := 3; b : INT := 2; END_VAR\nb := b - 1;\na := a / b;\nEND_PROGRAM\n")
+    r = plc("run", src, "--offline", "--for", "0.1", "--trace", "--watch", "b")
+    assert r.returncode == 70
+    assert r.stderr.startswith(f"{src}:4:8: error: division by zero")
+    assert "MAIN_TASK" in r.stderr and "main" in r.stderr
+    assert trace(r.stdout) == [{"t": 0.0, "scan": 0, "name": "b", "value": 1}]  # scan 1 stopped
+
+
+def test_endless_loop_is_stopped(tmp_path):
+    src = write(tmp_path, "loop.st", "PROGRAM main\nVAR i : INT; END_VAR\nWHILE TRUE DO\n  i := i + 1;\nEND_WHILE;\nEND_PROGRAM\n")
+    r = plc("run", src, "--offline", "--for", "0.1", "--loop-budget", "1000")
+    assert r.returncode == 70
+    assert r.stderr.startswith(f"{src}:3:1: error: the scan does not end")
+
+
+def test_run_without_offline_is_a_clear_usage_error(tmp_path):
+    src = write(tmp_path, "p.st", "PROGRAM main\nVAR i : INT; END_VAR\ni := 1;\nEND_PROGRAM\n")
+    r = plc("run", src, "--for", "0.1")
+    assert r.returncode == 2 and "--offline" in r.stderr
