@@ -557,7 +557,7 @@ class Checker:
             if bt.kind in ("fb", "program"):
                 s = bt.members[e.name.upper()]
                 if s.section == "VAR_OUTPUT":
-                    raise self.fail(f"'{e.name}' is an output of {bt.name}: only the block writes it", e.name_span)
+                    raise self.fail(f"'{e.name}' is an output of {bt.name}: only the block writes it", e.span)
             else:
                 self.lvalue(e.base, scope)
             return t
@@ -600,7 +600,7 @@ class Checker:
             up = e.name.upper()
             if up in self.pous or up in STANDARD_FBS:
                 raise self.fail(f"'{e.name}' is a POU, not a variable", e.span)
-            raise self.fail(f"'{e.name}' is not declared", e.span)
+            raise self.fail(f"undeclared name '{e.name}'", e.span)
         if isinstance(e, n.Member):
             bt = self.expr(e.base, scope)
             up = e.name.upper()
@@ -736,8 +736,10 @@ class Checker:
         if op == "**":
             if not ty.is_numeric(a) or not ty.is_numeric(b):
                 raise self.fail(f"'**' needs numbers, not {a} and {b}", e.op_span)
+            if a is ty.LIT_REAL or a is ty.LIT_INT and b is ty.LIT_REAL:
+                return ty.LIT_REAL  # a REAL or an LREAL, as the context needs
             if a.kind == "real":
-                return a if a is not ty.LIT_REAL else ty.LREAL
+                return a
             return ty.LREAL if b.kind == "real" else (a if a is not ty.LIT_INT else ty.LIT_INT)
         try:
             return ty.arith_type(op, a, b)
@@ -771,7 +773,7 @@ class Checker:
             raise self.fail(f"'{c.name}' is a function block type: declare an instance (t1 : {up};) and call it", c.span)
         if stdlib_fn.is_standard(up):
             return self.std_call(c, up, scope, expected)
-        raise self.fail(f"unknown function '{c.name}'", c.span)
+        raise self.fail(f"unknown function '{c.name}' (undeclared)", c.span)
 
     def fb_call(self, c: n.Call, fbt: ty.FbT, scope: _Scope, statement: bool) -> ty.DataType:
         if not statement:
@@ -867,7 +869,7 @@ class Checker:
         elif result is ty.LIT_INT:
             result = ty.DINT
         elif result is ty.LIT_REAL:
-            result = ty.LREAL
+            result = expected if expected is not None and expected.kind == "real" else ty.LREAL
         c.target = ("std", up)
         c.arg_values = values
         return result

@@ -409,6 +409,8 @@ class Parser:
             raise self.error(f"expected a statement, found {t.describe()}")
         if t.kind not in (Kind.IDENT, Kind.DIRECT):
             raise self.error(f"expected a statement, found {t.describe()}")
+        if t.upper in ("STEP", "TRANSITION", "ACTION") and self.peek().kind is Kind.IDENT:
+            raise self.error(f"{t.upper}: SFC (sequential function charts) is not supported")
         target = self.postfix(self.primary())
         if self.tok.is_op(":="):
             self.advance()
@@ -593,10 +595,10 @@ class Parser:
             e = self.expression()
             self.expect_op(")", " to close the parenthesis")
             return e
-        if t.kind is Kind.IDENT:
-            self.advance()
+        if t.kind is Kind.IDENT or (t.is_kw("MOD", "AND", "OR", "XOR") and self.peek().is_op("(")):
+            self.advance()  # `MOD(a, b)`, `AND(a, b, c)`: the operators' function forms
             if self.tok.is_op("("):
-                return n.Call(t.span, t.text, self.call_args())
+                return n.Call(t.span, t.upper if t.kind is Kind.KEYWORD else t.text, self.call_args())
             return n.Name(t.span, t.text)
         self.unsupported_check(t)
         if t.is_op("^"):

@@ -70,7 +70,7 @@ def _idiv(a, b, site):
 
 def _imod(a, b, site):
     if b == 0:
-        raise Fault("division by zero (MOD 0)", site)
+        return 0  # the standard: IF IN2 = 0 THEN OUT := 0
     q = abs(a) // abs(b)
     return a - (q if (a >= 0) == (b >= 0) else -q) * b
 

@@ -19,12 +19,13 @@ FORMALS = {
     "INSERT": ("IN1", "IN2", "P"), "DELETE": ("IN", "L", "P"), "REPLACE": ("IN1", "IN2", "L", "P"),
     "FIND": ("IN1", "IN2"), "EXPT": ("IN1", "IN2"),
 }
+_LOGIC = {"AND": "&", "OR": "|", "XOR": "^"}
 EXTENSIBLE = {"ADD", "MUL", "MAX", "MIN", "CONCAT", "MUX", "GT", "GE", "EQ", "LE", "LT", "AND", "OR", "XOR"}
 _MATH1 = {"SQRT": "_sqrt", "LN": "_ln", "LOG": "_log", "EXP": "_exp", "SIN": "_m.sin", "COS": "_m.cos",
           "TAN": "_m.tan", "ASIN": "_asin", "ACOS": "_acos", "ATAN": "_m.atan"}
 NAMES = {"ABS", "EXPT", "ADD", "SUB", "MUL", "DIV", "MOD", "MOVE", "SHL", "SHR", "ROL", "ROR", "SEL", "MAX", "MIN",
          "LIMIT", "MUX", "GT", "GE", "EQ", "LE", "LT", "NE", "LEN", "LEFT", "RIGHT", "MID", "CONCAT", "INSERT",
-         "DELETE", "REPLACE", "FIND", "TRUNC", "TIME", "ATAN2"} | set(_MATH1)
+         "DELETE", "REPLACE", "FIND", "TRUNC", "TIME", "ATAN2", "AND", "OR", "XOR"} | set(_MATH1)
 _DT_KINDS = ("time", "date", "tod", "dt")
 
 
@@ -109,7 +110,9 @@ def signature(name: str, ts: list[ty.DataType]) -> ty.DataType:
     if up in _MATH1:
         arity(1)
         _num(ts[0], up)
-        return ts[0] if ts[0].kind == "real" and ts[0] is not ty.LIT_REAL else ty.LREAL if ts[0].kind != "real" or ts[0] is ty.LIT_REAL else ts[0]
+        if ts[0] in (ty.LIT_INT, ty.LIT_REAL):
+            return ty.LIT_REAL
+        return ts[0] if ts[0].kind == "real" else ty.LREAL
     if up == "ATAN2":
         arity(2)
         return ty.LREAL
@@ -137,6 +140,14 @@ def signature(name: str, ts: list[ty.DataType]) -> ty.DataType:
     if up == "MOVE":
         arity(1)
         return ts[0]
+    if up in _LOGIC:
+        if n < 2:
+            raise SignatureError(f"{up} takes at least two arguments")
+        if all(t.kind == "bool" for t in ts):
+            return ty.BOOL
+        if all(t.kind in ("bits", "int") for t in ts):
+            return _common(ts, up)
+        raise SignatureError(f"{up} needs BOOLs or bit strings")
     if up in ("SHL", "SHR", "ROL", "ROR"):
         arity(2)
         if ts[0].kind not in ("bits", "int"):
@@ -180,7 +191,7 @@ def signature(name: str, ts: list[ty.DataType]) -> ty.DataType:
                 raise SignatureError(f"{up}'s argument {k + 1} is a STRING, not a {t}")
             if w == "i" and t.kind not in ("int", "bits"):
                 raise SignatureError(f"{up}'s argument {k + 1} is an integer, not a {t}")
-        return ty.DINT if up in ("LEN", "FIND") else ty.STRING
+        return ty.INT if up in ("LEN", "FIND") else ty.STRING
     if up == "CONCAT":
         if n < 2:
             raise SignatureError("CONCAT takes at least two arguments")
@@ -220,6 +231,15 @@ def generate(name: str, codes: list[str], ts: list[ty.DataType], result: ty.Data
         return divide(up, c[0], c[1], result, site)
     if up == "MOVE":
         return c[0]
+    if up in _LOGIC:
+        if result.kind == "bool":
+            if up == "XOR":
+                out = c[0]
+                for x in c[1:]:
+                    out = f"({out} != {x})"
+                return out
+            return "(" + f" {up.lower()} ".join(c) + ")"
+        return "(" + f" {_LOGIC[up]} ".join(c) + ")"
     bits = result.bits if hasattr(result, "bits") and result.kind in ("bits", "int") else 64
     mask = (1 << bits) - 1
     if up == "SHL":
@@ -277,6 +297,9 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
         elif sk == "string":
             inner = f"_str_to_int({code})"
         else:
+            if src.kind in ("int", "bits") and src is not ty.LIT_INT and ty.range_of(dst)[0] <= ty.range_of(src)[0] \
+                    and ty.range_of(src)[1] <= ty.range_of(dst)[1]:
+                return code  # a widening: nothing to wrap
             inner = code
         return wrap_code(dst, inner)
     if dk == "real":
@@ -288,6 +311,10 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
             inner = f"float({code})"
         return f"_f32({inner})" if dst.bits == 32 else inner
     if dk in _DT_KINDS:
+        if sk == "dt" and dk == "tod":
+            return f"(({code}) % 86400000000000)"
+        if sk == "dt" and dk == "date":
+            return f"(({code}) - ({code}) % 86400000000000)"
         if sk in _DT_KINDS:
             return code
         if sk == "real":
@@ -308,7 +335,7 @@ def wrap_code(t: ty.DataType, code: str) -> str:
     bits = t.bits
     if getattr(t, "signed", False):
         half = 1 << (bits - 1)
-        return f"((({code}) + {half}) & {(1 << bits) - 1}) - {half}"
+        return f"(((({code}) + {half}) & {(1 << bits) - 1}) - {half})"
     return f"(({code}) & {(1 << bits) - 1})"
 
 

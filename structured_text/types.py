@@ -207,7 +207,7 @@ def default_value(t: DataType):
     if isinstance(t, EnumT):
         return next(iter(t.values.values()))[1] if t.values else 0
     if isinstance(t, SubrangeT):
-        return t.lo if t.lo > 0 else (t.hi if t.hi < 0 else 0)
+        return t.lo  # the standard: a subrange starts at its lower limit
     return 0
 
 

@@ -32,7 +32,7 @@ def test_check_exit_codes_and_error_lines(tmp_path):
     assert r.returncode == 0, r.stderr
     r = plc("check", bad)
     assert r.returncode == 65
-    assert r.stderr.splitlines() == [f"{bad}:3:6: error: 'd' is not declared",
+    assert r.stderr.splitlines() == [f"{bad}:3:6: error: undeclared name 'd'",
                                      f"{bad}:4:6: error: type mismatch in the assignment: a BOOL cannot be stored in an INT "
                                      "(convert it: BOOL_TO_INT)"]
 

