@@ -1,6 +1,6 @@
 """Lexer: Structured Text source to a list of tokens, each with its line and column.
 
-Comments: `(* ... *)` (they do not nest: the first `*)` closes), `/* ... */` and `// ...` to the end of the line; pragmas
+Comments: `(* ... *)` (nested ones too, as the 3rd edition allows), `/* ... */` and `// ...` to the end of the line; pragmas
 `{ ... }` are skipped. Literals: integers with `_` separators, based integers (`16#FF`, `2#1010`,
 `8#17`), reals (`1.5`, `1.0E-3`), typed literals (`INT#5`, `REAL#1`, `BOOL#1`, `Color#Red`), durations
 (`T#1s500ms`, `TIME#-2.5s`, `T#1d2h3m4s5ms6us7ns`), dates and times of day (`D#2024-01-31`,
@@ -164,10 +164,16 @@ def lex(source: str, file: str = "<input>") -> list[Token]:
         start = i
         if source.startswith("(*", i) or source.startswith("/*", i):
             close = "*)" if ch == "(" else "*/"
-            j = source.find(close, i + 2)
-            if j < 0:
+            depth, j = 1, i + 2  # comments nest (IEC 61131-3 ed. 3, table 5)
+            while depth and j < n:
+                if source.startswith(source[i:i + 2], j):
+                    depth, j = depth + 1, j + 2
+                elif source.startswith(close, j):
+                    depth, j = depth - 1, j + 2
+                else:
+                    j += 1
+            if depth:
                 raise LexError("unterminated comment", span_at(start))
-            j += 2
             newlines(i, j)
             i = j
             continue

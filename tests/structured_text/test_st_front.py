@@ -29,7 +29,7 @@ def test_literals_have_the_standards_values():
 
 
 def test_comments_pragmas_and_direct_addresses():
-    toks = lex("(* a (* comment *) x // line\n{pragma} AT %QW100 %IX1.7", "t.st")  # comments do not nest
+    toks = lex("(* a (* nested *) comment *) x // line\n{pragma} AT %QW100 %IX1.7", "t.st")  # ed. 3 nests
     assert [t.text for t in toks[:-1]] == ["x", "AT", "%QW100", "%IX1.7"]
     assert toks[2].value == ("Q", "W", (100,))
     assert toks[3].span.line == 2
