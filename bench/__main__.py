@@ -17,6 +17,7 @@ BENCHMARKS = {
     "view": "bench.view",  # the live page and recording: late steps, page updates per s, recording cost per step
     "map": "bench.signal_map",  # twin map from the static signal table vs from a running cell
     "pollimage": "bench.poll_image",  # a master reading a poll in two requests: torn images with and without the hold
+    "record": "bench.recording",  # the flight recorder's cost per lockstep step, Parquet and CSV
 }
 
 

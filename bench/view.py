@@ -13,7 +13,6 @@
 from __future__ import annotations
 
 import argparse
-import statistics
 import tempfile
 import time
 from pathlib import Path
@@ -73,34 +72,10 @@ def realtime_run(seconds: float, view: bool, browser, record: bool | None = None
 
 
 def lockstep_cost(steps: int, blocks: int = 6) -> dict:
-    """Blocks of steps without and with the recorder attached, alternately; the file's last write and
-    footer (at close) are spread over the recorded steps."""
-    from twin_app.cell import open_cell
-    from twin.observe import attach, detach
-    from twin.recording import Recorder
+    """The recorder's cost per lockstep step (`bench.recording`, `python -m bench record`)."""
+    from bench.recording import lockstep_cost as cost
 
-    bare, recorded = [], []
-    with tempfile.TemporaryDirectory(prefix="bench-rec-") as tmp, open_cell(STATION) as twin:
-        twin.write("fullAutoRun", True)
-        twin.step(50)
-        rec = Recorder(twin, Path(tmp) / "run.parquet")
-        detach(twin, rec)
-        for _ in range(blocks):
-            t0 = time.perf_counter()
-            twin.step(steps)
-            bare.append((time.perf_counter() - t0) / steps)
-            attach(twin, rec)
-            t0 = time.perf_counter()
-            twin.step(steps)
-            recorded.append((time.perf_counter() - t0) / steps)
-            detach(twin, rec)
-        t0 = time.perf_counter()
-        rec.close()
-        closing = (time.perf_counter() - t0) / (steps * blocks)
-        columns, rows, size = len(rec.columns), rec.rows, (Path(tmp) / "run.parquet").stat().st_size
-    b, r = statistics.median(bare), statistics.median(recorded) + closing
-    return {"bare_us": b * 1e6, "rec_us": r * 1e6, "cost_us": (r - b) * 1e6, "columns": columns, "dt": twin.dt,
-            "bytes_per_row": size / rows}
+    return cost(steps, blocks)
 
 
 def main(argv: list[str]) -> int:

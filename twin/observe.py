@@ -148,6 +148,11 @@ class Observer:
             signals=[_signal_dict(s) for s in twin.signals])
         self._names = [s.name for s in twin.signals]
         self._base_pose_t = tuple(float(v) for v in self._base_pose)
+        # a fixture of mass 0 is static in pybullet (nothing moves it; only targets are placed and displaced):
+        # its pose is read once, not at every frame
+        fixtures = {f.name for f in st.fixtures}
+        self._static_pose = {uid: (*c.getBasePositionAndOrientation(uid)[0], *c.getBasePositionAndOrientation(uid)[1])
+                             for name, uid in self._others if name in fixtures and c.getDynamicsInfo(uid, -1)[0] == 0}
         self._other_ids = [uid for _, uid in self._others]
         self._cid = c._client  # the connection's id (BulletClient keeps it here)
         from twin.core.bullet import pybullet
@@ -194,13 +199,15 @@ class Observer:
             fingers.append(FingerView(f.name, tuple(f.links), tuple(chain)))
         return fingers
 
-    def raw(self) -> tuple:
+    def raw(self, values: tuple | None = None) -> tuple:
         """The state now as plain tuples: (step, time, values, poses flat (x y z qx qy qz qw per body), joints).
 
-        The cheap form a recorder keeps for every step; `frame()` makes a `Frame` of it."""
+        The cheap form a recorder keeps for every step; `frame()` makes a `Frame` of it. `values`: the
+        signals' values in `scene.signals`' order when the caller has them already (a published snapshot)."""
         twin, cid, pybullet = self.twin, self._cid, self._pb
-        read = twin.read
-        values = tuple([read(n) for n in self._names])
+        if values is None:
+            read = twin.read
+            values = tuple([read(n) for n in self._names])
         poses = list(self._base_pose_t)
         # pybullet's functions called directly with the connection's id: BulletClient's per-call wrapper
         # costs more than the calls themselves
@@ -211,7 +218,11 @@ class Observer:
             for s in states:
                 poses += s[4]
                 poses += s[5]
+        static = self._static_pose
         for uid in self._other_ids:
+            if uid in static:
+                poses += static[uid]
+                continue
             pos, orn = pybullet.getBasePositionAndOrientation(uid, physicsClientId=cid)
             poses += pos
             poses += orn

@@ -1,4 +1,4 @@
-"""Recordings: every signal at every step, and the pose of every body, in a columnar file.
+"""Recordings: every signal at every step, and the pose of every body, in a columnar file; a flight recorder.
 
     from twin.core import Twin
     from twin.recording import record, Recording
@@ -18,23 +18,36 @@ joint (m or rad). The file's metadata (`gripper_twin` key, JSON) holds the scene
 each signal's unit and range, each body's visuals, the fingers.
 
 Parquet (the default, any name but `.csv`) needs pyarrow (`pip install 'gripper-twin[view]'`): typed
-columns, compressed, read by pandas, polars, DuckDB, Excel's Power Query. A `.csv` file needs nothing
-(one header row, then one line per step; the scene goes beside it as FILE.csv.json). Either way the
-file depends only on the station and the inputs, step by step: a lockstep replay of the same inputs
-writes the same bytes (rows are written in groups of a fixed number of steps, no wall time, no host
+columns, compressed, read by pandas, polars, DuckDB, Excel's Power Query. A `.csv` file (one header row,
+then one line per step; the scene goes beside it as FILE.csv.json) is written with pyarrow's CSV writer
+when pyarrow is there, else with Python's. Either way the file depends only on the station and the
+inputs, step by step: a lockstep replay of the same inputs writes the same bytes (no wall time, no host
 name, no random ids).
 
-The recorder is a device of the twin (stepped with it, adding no signals): the core imports nothing of
-it. Rows are buffered and written in groups by one background thread, so a real-time server does not
-wait on the disk.
+A flight recorder: what was recorded survives the crash it should explain. Rows are buffered in groups
+of less than `FLUSH_S` (1 s) of simulated time, each written with one system call when it is full (in the
+stepping thread: a fraction of a millisecond per simulated second, and nothing in flight), so after a
+SIGKILL the file holds every step up to less than 1 s before it (the rows of the group being filled). A CSV file gets its lines directly. A Parquet file's footer is
+written only when it is finished, so while recording the file is an Arrow IPC stream (self-delimiting
+record batches, each readable on its own; narrow: the floats of a row in one fixed-size list, so a group
+costs a few buffers, not one per column) and closing converts it into Parquet in place (`finish`). After
+a crash the file is still that stream: `Recording.open` (so `twin plot`, `twin view --replay`,
+`twin snapshot`) reads every complete group of it, `finish(path)` turns it into Parquet. A graceful stop
+keeps every step.
+
+The recorder is a device of the twin (stepped with it, adding no signals), or, in a served cell, a
+subscriber of the exchange that takes the signals' values from the snapshot already published (`exchange`):
+the core imports nothing of it. See `python -m bench record` for what it costs a step.
 """
 from __future__ import annotations
 
 import contextlib
 import csv
+import io
 import json
 import math
-from concurrent.futures import ThreadPoolExecutor
+import os
+from itertools import islice
 from pathlib import Path
 
 import numpy as np
@@ -45,7 +58,10 @@ from .core.device import ObservingDevice
 
 FORMAT_VERSION = 1
 META_KEY = "gripper_twin"
-ROWS_PER_GROUP = 1024
+FLUSH_S = 1.0  # a group holds less than this much simulated time before it goes to the file (all a crash loses)
+STREAM_MAGIC = b"\xff\xff\xff\xff"  # an Arrow IPC stream's first message starts so; a Parquet file with b"PAR1"
+STREAM_END = b"\xff\xff\xff\xff\x00\x00\x00\x00"  # the end-of-stream mark (written by `close` only)
+PARQUET_ROW_GROUP = 65536
 
 
 class RecordingError(TwinError):
@@ -70,111 +86,230 @@ def _meta(scene: Scene) -> str:
     return json.dumps({"format": FORMAT_VERSION, "scene": scene.as_dict()}, sort_keys=True)
 
 
+class _Layout:
+    """Where each signal of a scene goes in a stream's narrow record batch: by kind, in the scene's order."""
+
+    KINDS = ("float64", "bool", "int64", "string")
+
+    def __init__(self, scene: Scene):
+        self.columns = columns_of(scene)
+        kinds = [t for _, t in self.columns[2:2 + len(scene.signals)]]
+        self.index = {k: [i for i, t in enumerate(kinds) if t == k] for k in self.KINDS}
+        self.n_poses, self.n_joints = 7 * len(scene.bodies), len(scene.joints)
+
+    def schema(self, pa, metadata: dict | None = None):
+        types = {"float64": pa.float64(), "bool": pa.bool_(), "int64": pa.int64(), "string": pa.string()}
+        fields = [("step", pa.int64()), ("time", pa.float64())]
+        fields += [(f"signals:{k}", pa.list_(types[k], len(self.index[k]))) for k in self.KINDS if self.index[k]]
+        fields += [(key, pa.list_(pa.float64(), width)) for key, width in (("poses", self.n_poses), ("joints", self.n_joints))
+                   if width]
+        return pa.schema(fields, metadata=metadata)
+
+    def batch(self, pa, schema, group: "_Group"):
+        """A group of rows -> one narrow record batch (a handful of buffers whatever the column count)."""
+        n = group.n
+        types = {"float64": float, "bool": bool, "int64": np.int64}
+        arrays = [pa.array(group.steps[:n]), pa.array(group.times[:n])]
+        vals = group.values[:n]
+        for kind in self.KINDS:
+            if not self.index[kind]:
+                continue
+            block = vals[:, self.index[kind]]
+            flat = [str(v) for v in block.ravel()] if kind == "string" else block.astype(types[kind]).ravel()
+            arrays.append(pa.FixedSizeListArray.from_arrays(
+                pa.array(flat, schema.field(f"signals:{kind}").type.value_type), len(self.index[kind])))
+        floats = group.floats[:n]
+        for block, width in ((floats[:, :self.n_poses], self.n_poses), (floats[:, self.n_poses:], self.n_joints)):
+            if width:
+                arrays.append(pa.FixedSizeListArray.from_arrays(pa.array(np.ascontiguousarray(block).ravel()), width))
+        return pa.RecordBatch.from_arrays(arrays, schema=schema)
+
+    def wide(self, pa, narrow) -> dict:
+        """A narrow table or batch -> {column name: numpy array}, in file order."""
+        n = narrow.num_rows
+
+        def block(key: str, width: int) -> np.ndarray:
+            col = narrow.column(key)
+            col = col.combine_chunks() if hasattr(col, "combine_chunks") else col
+            flat = col.flatten()
+            flat = flat.to_numpy(zero_copy_only=False)
+            return flat.reshape(n, width).T
+
+        names = [name for name, _ in self.columns]
+        out = {"step": narrow.column("step").to_numpy(), "time": narrow.column("time").to_numpy()}
+        signals = [None] * sum(len(v) for v in self.index.values())
+        for kind in self.KINDS:
+            if self.index[kind]:
+                for row, i in zip(block(f"signals:{kind}", len(self.index[kind])), self.index[kind]):
+                    signals[i] = row
+        for name, col in zip(names[2:], signals):
+            out[name] = col
+        rest = names[2 + len(signals):]
+        for key, width, cols in (("poses", self.n_poses, rest[:self.n_poses]), ("joints", self.n_joints, rest[self.n_poses:])):
+            if width:
+                for name, col in zip(cols, block(key, width)):
+                    out[name] = np.ascontiguousarray(col)
+        return out
+
+
+class _Group:
+    """Rows being buffered, in preallocated arrays: a row costs a few array stores and no objects the
+    garbage collector has to follow."""
+
+    def __init__(self, layout: _Layout, capacity: int):
+        self.n, self.t0 = 0, None
+        self.steps = np.empty(capacity, dtype=np.int64)
+        self.times = np.empty(capacity, dtype=float)
+        self.values = np.empty((capacity, sum(len(v) for v in layout.index.values())), dtype=object)
+        self.floats = np.empty((capacity, layout.n_poses + layout.n_joints), dtype=float)
+        self.n_poses = layout.n_poses
+
+    def add(self, row: tuple) -> bool:
+        """Store an Observer.raw row; False when full."""
+        i = self.n
+        if i == len(self.steps):
+            return False
+        self.steps[i], self.times[i], self.values[i], f = row[0], row[1], row[2], self.floats[i]
+        f[:self.n_poses], f[self.n_poses:] = row[3], row[4]
+        self.n = i + 1
+        if self.t0 is None:
+            self.t0 = row[1]
+        return True
+
+    def rows(self):
+        """The rows again as (step, time, values, poses, joints) tuples (the CSV writer without pyarrow)."""
+        for i in range(self.n):
+            f = self.floats[i]
+            yield int(self.steps[i]), float(self.times[i]), tuple(self.values[i]), f[:self.n_poses], f[self.n_poses:]
+
+
 class Recorder(ObservingDevice):
     """Records a twin at every step into `path` (see the module docstring). Close it to finish the file."""
 
     signals: tuple = ()  # a device of the twin with no signals of its own
 
-    def __init__(self, twin, path: str | Path, *, observer: Observer | None = None, rows_per_group: int = ROWS_PER_GROUP):
+    def __init__(self, twin, path: str | Path, *, observer: Observer | None = None, exchange=None,
+                 flush_s: float = FLUSH_S):
+        """`exchange` (a served cell's `twin.exchange.Exchange`): record each published snapshot (its values
+        are already read) instead of stepping with the twin."""
         self.path = Path(path)
         self.observer = observer or Observer(twin)
         self.scene = self.observer.scene
         self.columns = columns_of(self.scene)
-        self.rows_per_group = rows_per_group
-        self._rows: list[tuple] = []
-        self._writer = None
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="recorder")
-        self._pending = None
+        self.layout = _Layout(self.scene)
+        self.flush_s = flush_s
+        self._dt = twin.dt
+        self._capacity = max(16, int(math.ceil(flush_s / twin.dt)) + 2)  # rows of one group (FLUSH_S of steps)
+        self._group = _Group(self.layout, self._capacity)
+        self._fd = None
         self.rows = 0
         self.twin = twin
         self._closed = False
+        self._last_step = None
+        self._n_signals = len(self.scene.signals)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._open()
         except OSError as exc:
-            self._pool.shutdown()
             raise RecordingError(f"{self.path}: cannot write a recording: {exc.strerror or exc}") from None
         self.capture()  # step 0, or wherever the twin is now
-        attach(twin, self)
+        names = [sig["name"] for sig in self.scene.signals]
+        if exchange is not None and list(islice(exchange.snapshot.values, len(names))) != names:
+            exchange = None  # its snapshot does not list the signals first, in order: read them here
+        self._exchange = exchange
+        if exchange is not None:
+            self._unsubscribe = exchange.subscribe(on_snapshot=self._on_snapshot)
+        else:
+            attach(twin, self)
 
-    # -- the twin's side (as a device) --------------------------------------------------------------------
+    # -- the twin's side (as a device, or as the exchange's subscriber) ----------------------------------------
     def after_step(self, twin) -> None:
         self.capture()
 
-    def capture(self) -> None:
+    def _on_snapshot(self, snapshot) -> None:
+        if snapshot.step != self._last_step:  # a snapshot taken again at the same step is not a new row
+            self.capture(tuple(islice(snapshot.values.values(), self._n_signals)))
+
+    def capture(self, values: tuple | None = None) -> None:
         """Add the twin's present state as a row (the device does this after every step)."""
-        self._rows.append(self.observer.raw())
+        row = self.observer.raw(values)
+        group = self._group
+        if not group.add(row):
+            self._flush()
+            group = self._group
+            group.add(row)
+        self._last_step = row[0]
         self.rows += 1
-        if len(self._rows) >= self.rows_per_group:
+        if row[1] + self._dt - group.t0 >= self.flush_s - 1e-9:  # the next row would make it span flush_s
             self._flush()
 
     # -- the file --------------------------------------------------------------------------------------------
     def _open(self) -> None:
+        try:
+            import pyarrow as pa
+        except ImportError:
+            pa = None
+        self._pa = pa
         if is_parquet(self.path):
-            try:
-                import pyarrow as pa
-                import pyarrow.parquet as pq
-            except ImportError:
+            if pa is None:
                 raise RecordingError(f"{self.path}: a Parquet recording needs pyarrow (pip install 'gripper-twin[view]'); "
-                                     "or record to a .csv file") from None
-            types = {"int64": pa.int64(), "float64": pa.float64(), "bool": pa.bool_(), "string": pa.string()}
-            self._schema = pa.schema([(n, types[t]) for n, t in self.columns], metadata={META_KEY: _meta(self.scene)})
-            self._writer = pq.ParquetWriter(str(self.path), self._schema, compression="zstd")
+                                     "or record to a .csv file")
+            self._schema = self.layout.schema(pa, {META_KEY: _meta(self.scene)})
+            head = pa.BufferOutputStream()
+            with pa.ipc.new_stream(head, self._schema):  # the schema message (and an end mark, cut off)
+                pass
+            self._stream_head = head.getvalue().to_pybytes()
+            if self._stream_head.endswith(STREAM_END):
+                self._stream_head = self._stream_head[:-len(STREAM_END)]
+            self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+            _write_all(self._fd, self._stream_head)
         else:
-            self._file = open(self.path, "w", newline="", encoding="utf-8")
-            self._csv = csv.writer(self._file, lineterminator="\n")
-            self._csv.writerow([n for n, _ in self.columns])
             Path(str(self.path) + ".json").write_text(_meta(self.scene) + "\n", encoding="utf-8")
+            self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+            header = io.StringIO()
+            csv.writer(header, lineterminator="\n").writerow([n for n, _ in self.columns])
+            _write_all(self._fd, header.getvalue().encode("utf-8"))
+            if pa is not None:
+                self._schema = self.layout.schema(pa)
 
     def _flush(self) -> None:
-        rows, self._rows = self._rows, []
-        if not rows:
-            return
-        if self._pending is not None:
-            self._pending.result()  # one group at a time, in order; raises what the last write raised
-        self._pending = self._pool.submit(self._write_group, rows)
+        """Write the buffered group now, in the stepping thread: a write of a few hundred microseconds per
+        simulated second is cheaper than handing it to a thread (and nothing is in flight when the process dies)."""
+        rows, self._group = self._group, _Group(self.layout, self._capacity)
+        if rows.n:
+            self._write_group(rows)
 
-    def _write_group(self, rows: list[tuple]) -> None:
-        """Rows (Observer.raw tuples) -> one row group (Parquet) or lines (CSV). Runs in the writer thread."""
-        n_sig = len(self.scene.signals)
-        steps, times, values, poses, joints = zip(*rows)
-        values = list(zip(*values)) if n_sig else []
-        poses = np.array(poses, dtype=float).reshape(len(rows), -1)
-        joints = np.array(joints, dtype=float).reshape(len(rows), -1)
-        kinds = [t for _, t in self.columns[2:2 + n_sig]]
-        if self._writer is not None:
-            import pyarrow as pa
-
-            arrays = [pa.array(steps, pa.int64()), pa.array(times, pa.float64())]
-            for col, kind in zip(values, kinds):
-                arrays.append(_arrow_column(pa, col, kind))
-            arrays += [pa.array(poses[:, k]) for k in range(poses.shape[1])]
-            arrays += [pa.array(joints[:, k]) for k in range(joints.shape[1])]
-            self._writer.write_table(pa.Table.from_arrays(arrays, schema=self._schema))
+    def _write_group(self, rows: _Group) -> None:
+        """A group of rows -> one record batch (Parquet's stream) or lines (CSV), written with one
+        system call. Runs in the writer thread."""
+        pa = self._pa
+        if is_parquet(self.path):
+            sink = pa.BufferOutputStream()
+            with pa.ipc.new_stream(sink, self._schema) as w:
+                w.write_batch(self.layout.batch(pa, self._schema, rows))
+            data = sink.getvalue().to_pybytes()[len(self._stream_head):]  # the batch, without a second schema
+            data = data[:-len(STREAM_END)] if data.endswith(STREAM_END) else data  # nor an end mark
+        elif pa is not None:
+            data = _csv_lines(pa, self.layout, self.layout.batch(pa, self._schema, rows))
         else:
-            cols = [steps, [repr(t) for t in times]]
-            for col, kind in zip(values, kinds):
-                cols.append([_csv_text(v, kind) for v in col])
-            cols += [[repr(float(v)) for v in poses[:, k]] for k in range(poses.shape[1])]
-            cols += [[repr(float(v)) for v in joints[:, k]] for k in range(joints.shape[1])]
-            self._csv.writerows(zip(*cols))
+            data = _csv_lines_plain(self.layout, rows.rows())
+        _write_all(self._fd, data)
 
     def close(self) -> None:
-        """Write what is buffered and finish the file (a Parquet file is unreadable until then)."""
+        """Write what is buffered and finish the file (a Parquet file: the stream becomes Parquet)."""
         if self._closed:
             return
         self._closed = True
-        detach(self.twin, self)
+        if self._exchange is not None:
+            self._unsubscribe()
+        else:
+            detach(self.twin, self)
         try:
             self._flush()
-            if self._pending is not None:
-                self._pending.result()
         finally:
-            self._pool.shutdown()
-            if self._writer is not None:
-                self._writer.close()
-            else:
-                self._file.close()
+            os.close(self._fd)
+        if is_parquet(self.path):
+            finish(self.path)
 
     def __enter__(self) -> "Recorder":
         return self
@@ -183,16 +318,78 @@ class Recorder(ObservingDevice):
         self.close()
 
 
-_ARROW_TYPES = {"bool": "bool_", "int64": "int64", "string": "string", "float64": "float64"}
+def _write_all(fd: int, data: bytes) -> None:
+    while data:
+        data = data[os.write(fd, data):]
 
 
-def _arrow_column(pa, col, kind):
-    typ = getattr(pa, _ARROW_TYPES[kind])()
-    try:
-        return pa.array(col, typ)
-    except (pa.ArrowInvalid, pa.ArrowTypeError, TypeError):  # e.g. numpy scalars or ints among floats
-        conv = {"bool": bool, "int64": int, "string": str, "float64": float}[kind]
-        return pa.array([conv(v) for v in col], typ)
+def _csv_lines(pa, layout: _Layout, narrow) -> bytes:
+    """A batch as CSV lines (no header) by pyarrow's writer: bools as 1/0, floats in their shortest form."""
+    import pyarrow.csv as pcsv
+
+    types = {"int64": pa.int64(), "float64": pa.float64(), "bool": pa.int8(), "string": pa.string()}
+    wide = layout.wide(pa, narrow)
+    arrays = [pa.array(wide[n].astype(np.int8) if t == "bool" else wide[n], types[t]) for n, t in layout.columns]
+    sink = pa.BufferOutputStream()
+    pcsv.write_csv(pa.Table.from_arrays(arrays, names=[n for n, _ in layout.columns]), sink,
+                   write_options=pcsv.WriteOptions(include_header=False, quoting_style="needed"))
+    return sink.getvalue().to_pybytes()
+
+
+def _csv_lines_plain(layout: _Layout, rows) -> bytes:
+    """The same lines without pyarrow (Python's csv module)."""
+    kinds = [t for _, t in layout.columns[2:]]
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    for step, t, values, poses, joints in rows:
+        w.writerow([step, repr(t), *(_csv_text(v, k) for v, k in zip(values, kinds)),
+                    *(repr(float(v)) for v in poses), *(repr(float(v)) for v in joints)])
+    return out.getvalue().encode("utf-8")
+
+
+def _read_stream(path: Path):
+    """Every complete record batch of an Arrow IPC stream (a recording cut short: up to the last whole one)."""
+    import pyarrow as pa
+
+    data = pa.memory_map(str(path)) if path.stat().st_size else None
+    if data is None:
+        raise RecordingError(f"{path}: empty")
+    reader = pa.ipc.open_stream(data)
+    batches = []
+    while True:
+        try:
+            batches.append(reader.read_next_batch())
+        except StopIteration:
+            break
+        except (pa.ArrowInvalid, OSError, EOFError):  # the group being written when the process died
+            break
+    return reader.schema, pa.Table.from_batches(batches, schema=reader.schema)
+
+
+def finish(path: str | Path) -> Path:
+    """Turn a recording's Arrow IPC stream (a Parquet recording while it is written, or after a crash) into
+    the Parquet file it would have been, in place. A file that is Parquet already is left as it is."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    with open(path, "rb") as f:
+        if f.read(4) != STREAM_MAGIC:
+            return path
+    schema, narrow = _read_stream(path)
+    meta = (schema.metadata or {}).get(META_KEY.encode())
+    if meta is None:
+        raise RecordingError(f"{path}: an Arrow stream without gripper-twin metadata: not a recording")
+    scene = Scene.from_dict(json.loads(meta)["scene"])
+    layout = _Layout(scene)
+    wide = layout.wide(pa, narrow)
+    types = {"int64": pa.int64(), "float64": pa.float64(), "bool": pa.bool_(), "string": pa.string()}
+    out_schema = pa.schema([(n, types[t]) for n, t in layout.columns], metadata={META_KEY: meta})
+    table = pa.Table.from_arrays([pa.array(wide[n], types[t]) for n, t in layout.columns], schema=out_schema)
+    tmp = path.with_name(path.name + ".finishing")
+    pq.write_table(table, str(tmp), compression="zstd", row_group_size=PARQUET_ROW_GROUP)
+    os.replace(tmp, path)
+    return path
 
 
 def _csv_text(v, kind: str) -> str:
@@ -265,15 +462,24 @@ class Recording:
                 import pyarrow.parquet as pq
             except ImportError:
                 raise RecordingError(f"{path}: reading Parquet needs pyarrow (pip install 'gripper-twin[view]')") from None
+            with open(path, "rb") as f:
+                stream = f.read(4) == STREAM_MAGIC  # still being written, or cut short by a crash
             try:
-                table = pq.read_table(str(path))
+                table = _read_stream(path)[1] if stream else pq.read_table(str(path))
+            except RecordingError:
+                raise
             except Exception as exc:  # pyarrow's errors are of several kinds; all mean "not a readable file"
                 raise RecordingError(f"{path}: not a readable Parquet recording ({exc})") from None
             meta = (table.schema.metadata or {}).get(META_KEY.encode())
             if meta is None:
                 raise RecordingError(f"{path}: a Parquet file without gripper-twin metadata: not a recording")
             scene = Scene.from_dict(json.loads(meta)["scene"])
-            columns = {name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names}
+            if stream:
+                import pyarrow as pa
+
+                columns = _Layout(scene).wide(pa, table)
+            else:
+                columns = {name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names}
         else:
             meta_path = Path(str(path) + ".json")
             if not meta_path.is_file():
@@ -281,7 +487,9 @@ class Recording:
             scene = Scene.from_dict(json.loads(meta_path.read_text(encoding="utf-8"))["scene"])
             kinds = dict(columns_of(scene))
             with open(path, newline="", encoding="utf-8") as f:
-                rows = list(csv.reader(f))
+                text = f.read()
+            text = text[:text.rfind("\n") + 1]  # a line cut short by a crash is not a row
+            rows = list(csv.reader(io.StringIO(text, newline="")))
             if not rows:
                 raise RecordingError(f"{path}: empty")
             header, body = rows[0], rows[1:]

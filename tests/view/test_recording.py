@@ -58,7 +58,7 @@ def test_every_signal_at_every_step(tmp_path, suffix):
 def test_two_lockstep_runs_write_identical_files(tmp_path):
     pytest.importorskip("pyarrow")
     for k in (1, 2):
-        with Twin.from_station(SMART) as twin, record(twin, tmp_path / f"run{k}.parquet", rows_per_group=50):
+        with Twin.from_station(SMART) as twin, record(twin, tmp_path / f"run{k}.parquet", flush_s=0.3):
             script(twin)
     assert (tmp_path / "run1.parquet").read_bytes() == (tmp_path / "run2.parquet").read_bytes()
 
@@ -87,3 +87,51 @@ def test_a_file_that_is_no_recording_is_named(tmp_path):
     bad.write_text("not parquet")
     with pytest.raises(RecordingError, match="bad.parquet"):
         Recording.open(bad)
+
+
+@pytest.mark.parametrize("suffix", ["parquet", "csv"])
+def test_a_sigkilled_server_leaves_every_step_but_the_last_second_readable(tmp_path, suffix):
+    """`twin serve --lockstep --record FILE`, killed with SIGKILL (no chance to finish the file): the file is
+    read back and holds the steps 0..k in order, k at most 1 s of simulated time short of the last step
+    the client saw done, with the values the client wrote and read at those steps."""
+    pytest.importorskip("pyarrow")
+    import signal
+
+    from twin.recording import finish
+
+    path = tmp_path / f"crash.{suffix}"
+    with twin_server(RING, lockstep=True, extra_args=["--record", str(path)]) as server:
+        with server.client() as plc:
+            plc.advance(20)
+            plc.write(L2=330.0)
+            plc.advance(230)
+            seen = plc.read("sim.step", "sim.time_ms", "L2.actual")
+        server.process.send_signal(signal.SIGKILL)
+        server.process.wait(10)
+    rec = Recording.open(path)
+    dt = rec.scene.dt
+    last = int(rec.steps[-1])
+    assert list(rec.steps) == list(range(last + 1))  # every step from the start, none twice, in order
+    assert last <= seen["sim.step"] and (seen["sim.step"] - last) * dt <= 1.0  # at most 1 s of simulated time lost
+    assert last * dt > 1.0  # (and something was written while it ran)
+    assert rec.column("L2")[20] != pytest.approx(0.33) and rec.column("L2")[21] == pytest.approx(0.33)
+    if last == seen["sim.step"]:
+        assert rec.column("L2.actual")[-1] * 1000 == pytest.approx(seen["L2.actual"], abs=0.01)
+    if suffix == "parquet":  # a crashed Parquet recording is its stream: finish it into the Parquet file it would be
+        import pyarrow.parquet as pq
+
+        finish(path)
+        table = pq.read_table(path)
+        assert table.num_rows == last + 1 and table.column("step").to_pylist() == list(range(last + 1))
+        assert Recording.open(path).column("pose:L2:x").tolist() == rec.column("pose:L2:x").tolist()
+
+
+def test_a_line_cut_short_at_the_end_of_a_csv_recording_is_not_a_row(tmp_path):
+    path = tmp_path / "run.csv"
+    with Twin.from_station(SMART) as twin, record(twin, path):
+        script(twin, steps=30)
+    whole = Recording.open(path)
+    text = path.read_text()
+    path.write_text(text + text.splitlines()[-1][:25])  # a crash in the middle of a line
+    cut = Recording.open(path)
+    assert len(cut) == len(whole) == 31 and cut.column("time").tolist() == whole.column("time").tolist()

@@ -167,7 +167,7 @@ class RecorderFrontEnd:
     async def start(self, cell) -> list[str]:
         from twin.recording import Recorder
 
-        self.recorder = Recorder(cell.twin, self.path)
+        self.recorder = Recorder(cell.twin, self.path, exchange=cell.exchange)  # the values it publishes anyway
         return [f"recording every step into {self.path}"]
 
     def endpoints(self) -> list[dict]:
