@@ -9,8 +9,9 @@ from the runtime's output:
     ! files: parts/types.st                        more files of the same PLC (beside the file)
     ! trace: {"t": 0.0, "scan": 0, "name": "cnt", "value": 1}   the whole trace, line by line, in order
     ! cmd: check                                   run `plc check FILE` instead of `plc run`
-    ! error: 7:12 zero                             first stderr line is FILE:7:12: error: ... and its
-                                                   message holds every word (a|b: either), any case
+    ! error: 7:12 zero                             stderr is FILE:7:12: error: ... and its message holds
+                                                   every word (a|b: either), any case; several `error:`
+                                                   lines: one stderr line each, in that order
     ! exit: 70                                     the exit status (0 when not given)
     ! lreal: x,y                                   these names are LREAL: floats within 1e-12 (else 1e-6)
     ! exact: r                                     floats of these names compared exactly
@@ -54,7 +55,7 @@ TIME_TOLERANCE = 1e-9
 
 
 def expectations(path: Path) -> dict:
-    exp: dict = {"args": [], "files": [], "trace": [], "cmd": "run", "error": None, "exit": 0,
+    exp: dict = {"args": [], "files": [], "trace": [], "cmd": "run", "errors": [], "exit": 0,
                  "lreal": set(), "exact": set()}
     for line in path.read_text(encoding="utf-8").splitlines():
         s = line.strip()
@@ -72,7 +73,7 @@ def expectations(path: Path) -> dict:
             exp["cmd"] = rest
         elif key == "error":
             pos, _, words = rest.partition(" ")
-            exp["error"] = (pos, words.split())
+            exp["errors"].append((pos, words.split()))
         elif key == "exit":
             exp["exit"] = int(rest)
         elif key in ("lreal", "exact"):
@@ -146,13 +147,14 @@ def test_program(path: Path):
                     f"\n   got  {json.dumps(got[i]) if i < len(got) else '-'}"
                     for i in range(max(len(got), len(exp["trace"])))]
             pytest.fail("trace differs:\n" + "\n".join(diff))
-    if exp["error"]:
-        pos, words = exp["error"]
-        first = err.splitlines()[0] if err.strip() else ""
-        assert first.startswith(f"{path}:{pos}: error: "), f"want {path}:{pos}: error: ..., got:\n{err}"
-        message = first.split(": error: ", 1)[1].lower()
-        for word in words:
-            assert any(alt.lower() in message for alt in word.split("|")), f"{word!r} not in: {first}"
+    if exp["errors"]:
+        lines = [line for line in err.splitlines() if line.strip()]
+        assert len(lines) == len(exp["errors"]), f"want {len(exp['errors'])} error line(s), got:\n{err}"
+        for line, (pos, words) in zip(lines, exp["errors"]):
+            assert line.startswith(f"{path}:{pos}: error: "), f"want {path}:{pos}: error: ..., got:\n{err}"
+            message = line.split(": error: ", 1)[1].lower()
+            for word in words:
+                assert any(alt.lower() in message for alt in word.split("|")), f"{word!r} not in: {line}"
     else:
         assert err.strip() == "", err
 
@@ -161,6 +163,6 @@ def test_shlex_args_of_every_file_parse():
     """The corpus itself is well formed: every file has a run or a check with an expectation."""
     for path in FILES:
         exp = expectations(path)
-        assert exp["trace"] or exp["error"] or exp["exit"], path
+        assert exp["trace"] or exp["errors"] or exp["exit"] or exp["cmd"] == "check", path
         if exp["cmd"] == "run" and exp["trace"]:
             assert "--watch" in exp["args"] and "--for" in exp["args"], path
