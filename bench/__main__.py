@@ -15,7 +15,8 @@ BENCHMARKS = {
     "rapid": "bench.rapid_polling",  # RAPID polling loops offline: wall time per simulated second
     "opcua": "bench.opcua",  # OPC UA vs Modbus on the same cell: latency, change delay, 1000 monitored items
     "view": "bench.view",  # the live page and recording: late steps, page updates per s, recording cost per step
-    "map": "bench.signal_map",  # twin map from the static signal table vs from a running cell
+    "map": "bench.signal_map",
+    "st": "bench.st_scan",  # Structured Text PLC scan vs the Python PLC's, and a 2000-statement program  # twin map from the static signal table vs from a running cell
     "pollimage": "bench.poll_image",  # a master reading a poll in two requests: torn images with and without the hold
     "record": "bench.recording",  # the flight recorder's cost per lockstep step, Parquet and CSV
 }

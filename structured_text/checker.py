@@ -89,6 +89,7 @@ class _Scope:
         self.pou = pou
         self.checker = checker
         self.loops = 0
+        self.for_vars: list = []  # the control variables of the FOR loops being checked
 
     def lookup(self, name: str) -> Symbol | None:
         up = name.upper()
@@ -452,6 +453,9 @@ class Checker:
     def stmt(self, st: n.Stmt, scope: _Scope) -> None:
         if isinstance(st, n.Assign):
             tt = self.lvalue(st.target, scope)
+            if isinstance(st.target, n.Name) and st.target.ref in scope.for_vars:
+                raise self.fail(f"'{st.target.name}' is the control variable of the FOR loop around it: "
+                                "the loop alone changes it", st.target.span)
             vt = self.expr(st.value, scope, tt)
             self.need_assignable(tt, vt, st.value, "the assignment")
         elif isinstance(st, n.CallStmt):
@@ -473,7 +477,9 @@ class Checker:
                     et = self.expr(e, scope, vt)
                     self.need_assignable(vt, et, e, "the FOR loop's bound")
             scope.loops += 1
+            scope.for_vars.append(st.var.ref)
             self.stmts(st.body, scope)
+            scope.for_vars.pop()
             scope.loops -= 1
         elif isinstance(st, n.While):
             self.guard(self.condition, st.cond, scope, "WHILE")

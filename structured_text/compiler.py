@@ -14,10 +14,15 @@ from __future__ import annotations
 from . import nodes as n
 from . import stdlib_fn
 from . import types as ty
-from .checker import PouInfo, Program, Symbol
+from .checker import PouInfo, Program, Symbol, literal_int
 from .errors import CheckError
 from .rtlib import HELPERS, Budget, Sites, StructBase
 from .stdlib_fb import STANDARD_FBS, Clock
+
+def f32(code: str) -> str:
+    """Python rounding `code` to a 32-bit float, inline (a function call costs twice as much)."""
+    return f"_up(_pk({code}))[0]"
+
 
 _FITS_STD = {"ABS": False, "MAX": True, "MIN": True, "LIMIT": True, "SEL": True, "MUX": True, "MOVE": True,
              "LEN": True, "FIND": True, "SHL": True, "SHR": True, "ROL": True, "ROR": True, "TIME": True,
@@ -27,11 +32,18 @@ _FITS_STD = {"ABS": False, "MAX": True, "MIN": True, "LIMIT": True, "SEL": True,
 class Compiled:
     """The compiled program: its namespace (classes, functions, `_G`, `_clk`, images) and span table."""
 
-    def __init__(self, program: Program, source: str, namespace: dict, sites: Sites):
+    def __init__(self, program: Program, source: str, namespace: dict, sites: Sites, line_spans: list):
         self.program = program
         self.source = source
         self.ns = namespace
         self.sites = sites
+        self.line_spans = line_spans  # (line of the generated source, span of the ST statement), ascending
+
+    def span_of_line(self, line: int):
+        """The ST statement a line of the generated Python belongs to."""
+        import bisect
+        k = bisect.bisect_right([ln for ln, _ in self.line_spans], line) - 1
+        return self.line_spans[k][1] if k >= 0 else None
 
     def new_instances(self) -> dict:
         """Fresh globals and program instances (cold start values)."""
@@ -48,6 +60,7 @@ class Emitter:
         self.lines: list[str] = []
         self.level = 0
         self.tmp = 0
+        self.spans: list[tuple[int, object]] = []  # (index of the next line, the statement's span)
 
     def emit(self, line: str) -> None:
         self.lines.append("    " * self.level + line)
@@ -65,6 +78,7 @@ class Compiler:
         self.structs: dict[int, str] = {}
         self.struct_defs: list[str] = []
         self.pou: PouInfo | None = None
+        self.loop_vars: dict[int, tuple[str, int | None, int | None]] = {}  # FOR control symbols -> local, range
 
     def site(self, span) -> int:
         return self.sites.add(span)
@@ -80,6 +94,8 @@ class Compiler:
                 self.block_class(info)
         self.globals_class()
         source = "\n".join(self.struct_defs + o.lines) + "\n"
+        base = len(self.struct_defs) + 1
+        line_spans = [(base + k, span) for k, span in o.spans]
         ns: dict = dict(HELPERS)
         ns["StructBase"] = StructBase
         ns["_clk"] = Clock()
@@ -89,7 +105,7 @@ class Compiler:
             ns["STD_" + name] = cls
         code = compile(source, "<structured text>", "exec")
         exec(code, ns)
-        return Compiled(self.p, source, ns, self.sites)
+        return Compiled(self.p, source, ns, self.sites, line_spans)
 
     def globals_class(self) -> None:
         o = self.out
@@ -204,6 +220,7 @@ class Compiler:
 
     def stmt(self, st: n.Stmt) -> None:
         o = self.out
+        o.spans.append((len(o.lines), st.span))
         if isinstance(st, n.Assign):
             if isinstance(st.value, n.Call) and st.value.target and st.value.target[0] == "fn" and \
                     self.has_outputs(st.value.target[1]):
@@ -301,7 +318,6 @@ class Compiler:
             step_const = 1
         else:
             try:
-                from .checker import literal_int
                 step_const = literal_int(st.step)
             except Exception:
                 step_const = None
@@ -325,7 +341,13 @@ class Compiler:
         o.level += 1
         o.emit(f"{target} = {var}")
         self.budget(site)
+        lo, hi = literal_int(st.start), literal_int(st.end)
+        if lo is not None and hi is not None and step_const is not None and step_const < 0:
+            lo, hi = hi, lo
+        sym = st.var.ref
+        self.loop_vars[id(sym)] = (var, lo, hi)  # the body reads the control variable from the Python local
         self.block(st.body)
+        del self.loop_vars[id(sym)]
         o.level -= 1
         o.emit("else:")
         o.level += 1
@@ -372,7 +394,7 @@ class Compiler:
             if vt.kind == "real" and (fits and (vt.bits <= tt.bits) or vt is ty.LIT_REAL and tt.bits == 64):
                 return code
             if tt.bits == 32:
-                return f"_f32({code})"
+                return f32(code)
             return code if vt.kind == "real" else f"float({code})"
         if k == "string":
             if isinstance(vt, ty.StringT) and vt.length <= tt.length:
@@ -472,6 +494,9 @@ class Compiler:
             ref = e.ref
             if isinstance(ref, tuple):  # an enumeration value
                 return repr(ref[2]), True
+            loop = self.loop_vars.get(id(ref))
+            if loop is not None:
+                return loop[0], True
             return self.symbol_code(ref), True
         if isinstance(e, n.Member):
             base = self.expr(e.base)[0]
@@ -519,7 +544,6 @@ class Compiler:
         return f"self.{s.attr}"
 
     def offset(self, e: n.Index, at: ty.ArrayT) -> str:
-        from .checker import literal_int
         parts = []
         stride = 1
         strides = []
@@ -534,7 +558,11 @@ class Compiler:
                 const += (v - lo) * s
                 continue
             code = self.expr(ix)[0]
-            term = f"_ix({code}, {lo}, {hi}, {self.site(ix.span)})"
+            loop = self.loop_vars.get(id(ix.ref)) if isinstance(ix, n.Name) else None
+            if loop is not None and loop[1] is not None and lo <= loop[1] and loop[2] <= hi:
+                term = f"({code} - {lo})" if lo else code  # a FOR variable whose range lies within the bounds
+            else:
+                term = f"_ix({code}, {lo}, {hi}, {self.site(ix.span)})"
             parts.append(term if s == 1 else f"{term} * {s}")
         if const or not parts:
             parts.append(repr(const))
@@ -566,12 +594,12 @@ class Compiler:
         if op in ("/", "MOD"):
             code = stdlib_fn.divide(op, a, b, t, self.site(e.op_span))
             if t.kind == "real" and t.bits == 32:
-                return f"_f32({code})", True
+                return f32(code), True
             return code, t.kind in ("time",)
         if op == "**":
             code = f"_expt({a}, {b}, {self.site(e.op_span)})"
             if t.kind == "real":
-                return (f"_f32({code})", True) if t.bits == 32 else (code, True)
+                return (f32(code), True) if t.bits == 32 else (code, True)
             return code, False
         pyop = op
         if t.kind == "time" and op == "*" and (lt.kind == "real" or rt.kind == "real"):
@@ -579,7 +607,7 @@ class Compiler:
         code = f"({a} {pyop} {b})"
         if t.kind == "real":
             if t.bits == 32:
-                return f"_f32{code}", True
+                return f32(code), True
             return code, True
         if t.kind in ("time", "date", "tod", "dt"):
             return code, True
@@ -608,6 +636,6 @@ class Compiler:
             if conv is not None:
                 return code, True
             if c.ty.kind == "real" and c.ty.bits == 32 and up not in ("MAX", "MIN", "LIMIT", "SEL", "MUX", "MOVE"):
-                return f"_f32({code})", True
+                return f32(code), True
             return code, _FITS_STD.get(up, False)
         raise CheckError("a function block call is a statement", c.span)

@@ -41,6 +41,10 @@ class Budget:
         self.left = 0
 
 
+_pk = _pack
+_up = _unpack
+
+
 def _f32(x):
     try:
         return _unpack(_pack(x))[0]
@@ -243,4 +247,5 @@ class StructBase:
 
 HELPERS = {name: obj for name, obj in globals().items() if name.startswith("_") and callable(obj)
            and not name.startswith("__")}
+HELPERS["_pk"], HELPERS["_up"] = _pack, _unpack
 HELPERS["_m"] = _m

@@ -212,6 +212,8 @@ class Plc:
                     self.fault = PlcFault(f.message, self.compiled.sites.spans[f.site], task.name, name)
                 except RecursionError:
                     self.fault = PlcFault("calls nested too deeply (recursion)", None, task.name, name)
+                except (OverflowError, ValueError, TypeError, ZeroDivisionError) as exc:
+                    self.fault = PlcFault(_describe(exc), self._where(exc), task.name, name)
                 if self.fault is not None:
                     raise self.fault
         for obj, attr, image, key in self._located_out:
@@ -219,6 +221,15 @@ class Plc:
         self.scans += 1
         for hook in self.trace_hooks:
             hook(self, now_ns / 1e9)
+
+    def _where(self, exc: BaseException):
+        """The ST statement that was running when Python raised `exc`: its span, from the generated code's line."""
+        tb, line = exc.__traceback__, None
+        while tb is not None:
+            if tb.tb_frame.f_code.co_filename == "<structured text>":
+                line = tb.tb_lineno
+            tb = tb.tb_next
+        return None if line is None else self.compiled.span_of_line(line)
 
     def base_cycle(self) -> int | None:
         """The greatest common divisor of the task intervals (ns), None when a task runs every scan."""
@@ -405,6 +416,14 @@ class VarRef:
         for o, a, image, key in self.plc._located_in:
             if o is target and a == attr:
                 image[key] = value
+
+
+def _describe(exc: BaseException) -> str:
+    if isinstance(exc, OverflowError):
+        return "arithmetic overflow: a REAL beyond +-3.4E38 (or a number too large to convert)"
+    if isinstance(exc, ZeroDivisionError):
+        return "division by zero"
+    return f"a value this runtime cannot compute ({type(exc).__name__}: {exc})"
 
 
 def coerce(t: ty.DataType, value):

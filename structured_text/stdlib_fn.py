@@ -309,7 +309,7 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
             inner = f"({code} / 1000000)"
         else:
             inner = f"float({code})"
-        return f"_f32({inner})" if dst.bits == 32 else inner
+        return f"_up(_pk({inner}))[0]" if dst.bits == 32 else inner
     if dk in _DT_KINDS:
         if sk == "dt" and dk == "tod":
             return f"(({code}) % 86400000000000)"

@@ -11,7 +11,7 @@ from pathlib import Path
 from tests.conftest import ROOT, STATIONS
 from tests.app.test_package_graph import imports_of
 
-GENERAL_PACKAGES = ("twin", "twin_app", "plc_client", "rapid_like")
+GENERAL_PACKAGES = ("twin", "twin_app", "plc_client", "rapid_like", "structured_text")
 # Words a station uses that are also the general vocabulary of every cell, with the reason.
 GENERAL_WORDS = {
     "ring": "a body shape of the station format (shape = \"ring\"), not only the ring rig's part",

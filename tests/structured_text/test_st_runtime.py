@@ -1,0 +1,241 @@
+"""The runtime through its embedding API: the standard blocks against the standard's timing diagrams and
+algebra, tasks, RETAIN, process images, STOP; and the bench at a tiny size."""
+from __future__ import annotations
+
+import pytest
+
+from structured_text.errors import PlcFault
+from structured_text.runtime import Plc, compile_files
+
+MS = 1_000_000
+
+
+def plc_of(tmp_path, text: str, name: str = "p.st") -> Plc:
+    path = tmp_path / name
+    path.write_text(text)
+    return Plc(compile_files([path]))
+
+
+def run(plc: Plc, scans: int, cycle_ms: int, drive: dict, watch: list[str]) -> list[tuple]:
+    """Scan k at k x cycle; drive: {scan: {name: value}} set before that scan; returns (scan, values...)."""
+    rows = []
+    for k in range(scans):
+        for name, value in drive.get(k, {}).items():
+            plc.set(name, value)
+        plc.scan_ns(k * cycle_ms * MS)
+        rows.append((k, *(plc.get(w) for w in watch)))
+    return rows
+
+
+TIMERS = """
+PROGRAM main
+VAR inp : BOOL; ton1 : TON; tof1 : TOF; tp1 : TP; END_VAR
+ton1(IN := inp, PT := T#30ms);
+tof1(IN := inp, PT := T#30ms);
+tp1(IN := inp, PT := T#30ms);
+END_PROGRAM
+"""
+
+
+def test_ton_delays_the_rise_and_follows_the_fall(tmp_path):
+    # IEC 61131-3 TON diagram: Q rises PT after IN rose (if IN stayed TRUE); ET counts up to PT and stays;
+    # IN FALSE resets Q and ET at once; a pulse shorter than PT gives no Q.
+    plc = plc_of(tmp_path, TIMERS)
+    rows = run(plc, 12, 10, {1: {"inp": True}, 3: {"inp": False}, 4: {"inp": True}, 9: {"inp": False}},
+               ["ton1.Q", "ton1.ET"])
+    q = [r[1] for r in rows]
+    et = [r[2] // MS for r in rows]
+    assert q == [False, False, False, False, False, False, False, True, True, False, False, False]
+    assert et == [0, 0, 10, 0, 0, 10, 20, 30, 30, 0, 0, 0]
+
+
+def test_tof_holds_q_pt_after_the_fall(tmp_path):
+    # TOF: Q follows IN's rise at once and falls PT after IN fell; ET counts from the fall, 0 while IN.
+    plc = plc_of(tmp_path, TIMERS)
+    rows = run(plc, 10, 10, {1: {"inp": True}, 3: {"inp": False}}, ["tof1.Q", "tof1.ET"])
+    assert [r[1] for r in rows] == [False, True, True, True, True, True, False, False, False, False]
+    assert [r[2] // MS for r in rows] == [0, 0, 0, 0, 10, 20, 30, 30, 30, 30]
+
+
+def test_tp_gives_one_pulse_of_pt_not_retriggered(tmp_path):
+    # TP: a rising edge starts a pulse of PT; edges during the pulse do nothing; after it ET stays PT while
+    # IN is TRUE and returns to 0 once IN is FALSE.
+    plc = plc_of(tmp_path, TIMERS)
+    rows = run(plc, 10, 10, {1: {"inp": True}, 2: {"inp": False}, 3: {"inp": True}, 5: {"inp": True},
+                             7: {"inp": False}}, ["tp1.Q", "tp1.ET"])
+    assert [r[1] for r in rows] == [False, True, True, True, False, False, False, False, False, False]
+    assert [r[2] // MS for r in rows] == [0, 0, 10, 20, 30, 30, 30, 0, 0, 0]
+
+
+def test_counters_bistables_and_edges_follow_the_standards_algebra(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR cu, cd, r, ld, s : BOOL; up : CTU; dn : CTD; ud : CTUD; sr1 : SR; rs1 : RS; rt : R_TRIG; ft : F_TRIG; END_VAR
+up(CU := cu, R := r, PV := 2);
+dn(CD := cd, LD := ld, PV := 2);
+ud(CU := cu, CD := cd, R := r, LD := ld, PV := 2);
+sr1(S1 := s, R := r);
+rs1(S := s, R1 := r);
+rt(CLK := cu);
+ft(CLK := cu);
+END_PROGRAM
+""")
+    plc.scan_ns(0)
+    assert plc.get("ft.Q") is True  # F_TRIG: Q := NOT CLK AND NOT M, M starts FALSE: TRUE on the first call
+    pulses = []
+    for k in range(1, 9):  # CU toggles: rising edges on scans 1, 3, 5, 7
+        plc.set("cu", k % 2 == 1)
+        plc.scan_ns(k * 10 * MS)
+        pulses.append(plc.get("rt.Q"))
+    assert pulses == [True, False] * 4
+    assert plc.get("up.CV") == 4 and plc.get("up.Q")  # counts past PV (PVmax is the limit, not PV)
+    assert plc.get("ud.CV") == 4 and plc.get("ud.QU") and not plc.get("ud.QD")
+    plc.set("cd", True)  # CU and CD both rise: CTUD does not count
+    plc.set("cu", True)
+    plc.scan_ns(100 * MS)
+    assert plc.get("ud.CV") == 4
+    plc.set("ld", True)
+    plc.scan_ns(110 * MS)
+    assert plc.get("dn.CV") == 2 and plc.get("ud.CV") == 2
+    plc.set("s", True)
+    plc.set("r", True)  # set and reset together: SR's set dominates, RS's reset dominates
+    plc.scan_ns(120 * MS)
+    assert plc.get("sr1.Q1") is True and plc.get("rs1.Q1") is False
+    assert plc.get("up.CV") == 0 and plc.get("ud.CV") == 0  # R dominates LD in CTUD
+
+
+def test_ctu_stops_at_the_top_of_its_type(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR c : CTU; k : INT; END_VAR
+c(CU := FALSE, R := FALSE, PV := 5);
+FOR k := 1 TO 3 DO c(CU := TRUE, PV := 5); c(CU := FALSE, PV := 5); END_FOR;
+END_PROGRAM
+""")
+    plc.set("c.CV", 32766)
+    plc.scan_ns(0)
+    assert plc.get("c.CV") == 32767  # PVmax of INT: no wrap to -32768
+
+
+TASKS = """
+PROGRAM Fast
+VAR_EXTERNAL log : DINT; END_VAR
+VAR n : INT; END_VAR
+n := n + 1;
+log := (log * 10 + 1) MOD 100000000;
+END_PROGRAM
+PROGRAM Slow
+VAR_EXTERNAL log : DINT; END_VAR
+VAR n : INT; END_VAR
+n := n + 1;
+log := (log * 10 + 2) MOD 100000000;
+END_PROGRAM
+CONFIGURATION cell
+  VAR_GLOBAL log : DINT; END_VAR
+  RESOURCE cpu ON PLC
+    TASK fastT (INTERVAL := T#10ms, PRIORITY := 2);
+    TASK slowT (INTERVAL := T#25ms, PRIORITY := 1);
+    PROGRAM f WITH fastT : Fast;
+    PROGRAM s WITH slowT : Slow;
+  END_RESOURCE
+END_CONFIGURATION
+"""
+
+
+def test_tasks_run_at_their_intervals_higher_priority_first(tmp_path):
+    plc = plc_of(tmp_path, TASKS)
+    assert plc.base_cycle() == 5 * MS  # gcd(10 ms, 25 ms)
+    logs = []
+    for k in range(11):  # t = 0 .. 50 ms
+        plc.scan_ns(k * 5 * MS)
+        logs.append(plc.get("log"))
+    # t=0: both (slow first: PRIORITY 1); 10, 20: fast; 25: slow; 30, 40: fast; 50: both, slow first
+    assert logs == [21, 21, 211, 211, 2111, 21112, 211121, 211121, 2111211, 2111211, 211121121 % 100_000_000]
+    assert plc.get("f.n") == 6 and plc.get("s.n") == 3
+
+
+def test_retain_survives_a_warm_restart_and_not_a_cold_one(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR RETAIN kept : INT := 7; END_VAR
+VAR lost : INT := 7; END_VAR
+kept := kept + 1;
+lost := lost + 1;
+END_PROGRAM
+""")
+    for k in range(3):
+        plc.scan_ns(k * 10 * MS)
+    assert (plc.get("kept"), plc.get("lost")) == (10, 10)
+    plc.warm_restart()
+    plc.scan_ns(30 * MS)
+    assert (plc.get("kept"), plc.get("lost")) == (11, 8)
+    plc.cold_restart()
+    plc.scan_ns(0)
+    assert (plc.get("kept"), plc.get("lost")) == (8, 8)
+
+
+def test_located_variables_go_through_the_process_images(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR
+  start AT %IX100.0 : BOOL;
+  level AT %IW100 : INT;
+  motor AT %QX100.0 : BOOL;
+  speed AT %QW100 : INT;
+  count AT %MD4 : DINT;
+END_VAR
+motor := start;
+speed := level * 2;
+count := count + 1;
+END_PROGRAM
+""")
+    plc.write_located("%IX100.0", True)
+    plc.write_located("%IW100", 21)
+    plc.scan(0.0)
+    assert plc.read_located("%QX100.0") is True and plc.read_located("%QW100") == 42
+    assert plc.read_located("%MD4") == 1
+    plc.write_located("%IX100.0", False)
+    plc.scan(0.01)
+    assert plc.read_located("%QX100.0") is False and plc.get("main.count") == 2
+
+
+def test_a_runtime_error_keeps_the_plc_in_stop(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR a : ARRAY[1..3] OF INT; i : INT := 2; END_VAR
+i := i + 1;
+a[i] := 1;
+END_PROGRAM
+""")
+    plc.scan_ns(0)
+    with pytest.raises(PlcFault) as e:
+        plc.scan_ns(10 * MS)
+    assert (e.value.span.line, e.value.span.col) == (5, 3) and "out of bounds" in e.value.message
+    assert e.value.task == "MAIN_TASK" and e.value.instance == "main"
+    with pytest.raises(PlcFault):
+        plc.scan_ns(20 * MS)
+    plc.cold_restart()
+    plc.scan_ns(0)
+
+
+def test_runs_are_repeatable_bit_for_bit(tmp_path):
+    text = """
+PROGRAM main
+VAR r : REAL := 0.1; x : LREAL := 1.0; t : TON; END_VAR
+r := r * 1.1 + SIN(r);
+x := x * 1.0000001 + SQRT(x);
+t(IN := NOT t.Q, PT := T#20ms);
+END_PROGRAM
+"""
+    a, b = plc_of(tmp_path, text, "a.st"), plc_of(tmp_path, text, "b.st")
+    for k in range(50):
+        a.scan_ns(k * 10 * MS)
+        b.scan_ns(k * 10 * MS)
+        assert (a.get("r"), a.get("x"), a.get("t.ET")) == (b.get("r"), b.get("x"), b.get("t.ET"))
+
+
+def test_the_bench_runs_at_a_tiny_size(capsys):
+    from bench.st_scan import main
+    assert main(["--scans", "30", "--statements", "60", "--repeat", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "ST / Python" in out and "60-statement program" in out
