@@ -200,8 +200,8 @@ _MISSING = object()
 
 
 def default_watch(plc) -> list[str]:
-    """Every elementary variable of every program instance (unqualified when there is one instance)."""
-    from .checker import Symbol  # noqa: F401
+    """Every elementary variable of every program instance (unqualified when there is one instance), then the
+    elementary globals."""
     names = []
     single = len(plc.program.instances) == 1
     for inst in plc.program.instances:
@@ -209,8 +209,8 @@ def default_watch(plc) -> list[str]:
             if s.section == "VAR_EXTERNAL" or s.type.kind in ("fb", "program", "array", "struct"):
                 continue
             names.append(s.name if single else f"{inst.name}.{s.name}")
+    for s in plc.program.globals.values():
+        if s.type.kind not in ("fb", "program", "array", "struct") and not s.constant and s.name not in names:
+            names.append(s.name)
     return names
 
-
-def _split_st_argv(argv: list[str]) -> tuple[str, list[str]] | None:
-    return None
