@@ -32,7 +32,7 @@ import logging
 import sys
 
 from twin.cli_args import positive_float, positive_int
-from twin.core.errors import TwinError
+from twin.core.errors import TwinError, one_line
 from twin.modbus.protocol import DEFAULT_PORT, TLS_PORT
 
 from .checks import check_names, check_value, lookup, range_text
@@ -396,8 +396,7 @@ def print_rows(rows, header: bool = False) -> None:
             print("  ".join("-" * w for w in widths))
 
 
-class UsageError(PlcClientError):
-    """A command line that cannot work (exit status 2)."""
+from twin.core.errors import UsageError  # noqa: E402  (the project's one: a TwinError, exit status 2)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -413,10 +412,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return args.func(args)
     except (ConnectionFailedError, ModbusExceptionError) as exc:
-        print(f"plc: error: {exc}", file=sys.stderr)
+        print(f"plc: {one_line(exc)}", file=sys.stderr)
         return EXIT_CONNECTION
-    except TwinError as exc:  # PlcClientError, MapError (a map that cannot be loaded or is not the server's)
-        print(f"plc: error: {exc}", file=sys.stderr)
+    except TwinError as exc:  # PlcClientError, MapError, a station's or a program's error: one line
+        print(f"plc: {one_line(exc)}", file=sys.stderr)
         return EXIT_USER
     except BrokenPipeError:  # `plc watch ... | head`
         return 0

@@ -45,8 +45,7 @@ from .parser import parse
 EX_OK, EX_USAGE, EX_DATAERR, EX_NOINPUT, EX_SOFTWARE = 0, 2, 65, 66, 70
 
 
-class UsageError(Exception):
-    pass
+from twin.core.errors import UsageError  # noqa: E402  (the project's one: a TwinError)
 
 
 def parse_io(items: list[str]) -> list[SignalInfo]:
@@ -155,6 +154,17 @@ def _program_first(argv: list[str]) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """`rapid check|run ...`; any other error of the project's (a TwinError) is one line and exit status 2."""
+    from twin.core.errors import TwinError, one_line
+
+    try:
+        return _main(argv)
+    except TwinError as exc:
+        print(f"rapid: {one_line(exc)}", file=sys.stderr)
+        return 2
+
+
+def _main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(_program_first(argv))
     out, err = sys.stdout, sys.stderr

@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from twin.core.errors import TwinError  # the project's one error tree
+
 
 @dataclass(frozen=True)
 class Span:
@@ -27,7 +29,7 @@ class Span:
         return f"{self.file}:{self.line}:{self.col}"
 
 
-class RapidError(Exception):
+class RapidError(TwinError):
     """Base class of every error the interpreter reports to the user."""
 
     kind = "error"

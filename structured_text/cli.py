@@ -30,8 +30,7 @@ from .lexer import parse_duration
 EX_OK, EX_USAGE, EX_DATAERR, EX_NOINPUT, EX_SOFTWARE = 0, 2, 65, 66, 70
 
 
-class UsageError(Exception):
-    pass
+from twin.core.errors import UsageError  # noqa: E402  (the project's one: a TwinError)
 
 
 class _Parser(argparse.ArgumentParser):

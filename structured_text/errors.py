@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from twin.core.errors import TwinError  # the project's one error tree
+
 
 @dataclass(frozen=True)
 class Span:
@@ -26,7 +28,7 @@ class Span:
         return f"{self.file}:{self.line}:{self.col}"
 
 
-class StError(Exception):
+class StError(TwinError):
     """Base class of every error the runtime reports to the user."""
 
     def __init__(self, message: str, span: Span | None):

@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .core.errors import SignalError
+from .core.errors import SignalError, TwinError
 from .core.signals import FLOAT, INPUT
 from .core.device import ObservingDevice
 
@@ -37,7 +37,7 @@ EPS = 1e-9
 JAM_REACHED = {"m": 0.0001, "rad": 0.001}  # a joint this close to its jam position is stuck there
 
 
-class FaultError(ValueError):
+class FaultError(TwinError):
     """A fault that does not fit the twin (an unknown target, input or signal): names the fault and why."""
 
 

@@ -20,12 +20,12 @@ import importlib.util
 import sys
 from pathlib import Path
 
-from .core.errors import StationError
+from .core.errors import StationError, TwinError
 from .moved import SHIPPED_STATIONS, shipped_plugin_tables  # the ready cells installed with the project
 
 
 
-class LoadError(ValueError):
+class LoadError(TwinError):
     """A reference that does not lead to an object: says which part failed."""
 
 

@@ -33,6 +33,7 @@ import logging
 import math
 from collections.abc import Callable, Mapping
 
+from twin.core.errors import SignalError, TwinError
 from twin.core.signal_table import COMM_LOST, watchdog_signals
 from twin.core.defaults import SAFE_STATES
 
@@ -45,7 +46,7 @@ class Watchdog:
                  open_setpoints: Mapping[str, float] | None = None,
                  log: Callable[[str], None] | None = None):
         if safe_state not in SAFE_STATES:
-            raise ValueError(f"safe state {safe_state!r}: one of {', '.join(SAFE_STATES)}")
+            raise TwinError(f"watchdog: safe state {safe_state!r}: one of {', '.join(SAFE_STATES)}")
         self.timeout = timeout if timeout and timeout > 0 else None
         self.safe_state = safe_state
         self.open_setpoints = dict(open_setpoints or {})
@@ -103,7 +104,7 @@ class Watchdog:
         return self.lost
 
     def write(self, name: str, value) -> None:
-        raise ValueError(f"{name} is an output of the watchdog")
+        raise SignalError(name, "an output of the watchdog: it cannot be written")
 
     def before_step(self, twin) -> None:
         pass

@@ -26,7 +26,7 @@ import sys
 from pathlib import Path
 
 from twin.cli_args import positive_float
-from twin.core.errors import TwinError
+from twin.core.errors import TwinError, one_line
 from twin.modbus.cli import add_commands as add_modbus_commands, tls_from_args
 from twin.modbus.log import announce, log as _log
 
@@ -294,21 +294,14 @@ def main(argv: list[str] | None = None) -> int:
     args = parse_command_line(build_parser(), argv)  # a station's demo keeps its own options
     try:
         return args.func(args)
-    except TwinError as exc:
-        print(f"twin: error: {exc}", file=sys.stderr)
+    except TwinError as exc:  # one line (the station's RAPID program: FILE:LINE:COL: error: ...)
+        print(f"twin: {one_line(exc)}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # `twin info ... | head`: the reader left; no traceback, and none at exit either
         import os
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
-    except Exception as exc:
-        from rapid_like.errors import RapidError
-
-        if not isinstance(exc, RapidError):
-            raise
-        print(f"twin: {exc.headline()}", file=sys.stderr)  # the station's RAPID program: FILE:LINE:COL
-        return 2
     except KeyboardInterrupt:
         return 130
 

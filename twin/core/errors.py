@@ -1,15 +1,26 @@
-"""Errors raised by the twin core.
+"""The project's one error tree: everything gripper-twin raises for a user's mistake or a plant condition.
 
-    TwinError                 base of everything the core raises on purpose
-    ├── StationError          a station file or a model it names is wrong (names file and key)
-    ├── MechanismError        a gripper URDF cannot be turned into a mechanism
-    ├── SignalError           unknown signal name, or a write to an output
-    │   ├── SignalTypeError   a value of the wrong type for the signal (text for a number, NaN, ...)
-    │   └── SignalRangeError  a value outside the signal's range (never clamped)
-    └── MotionError           the robot cannot reach a target (names the target)
+    TwinError                     base: `except TwinError` catches all of them (and nothing else)
+    ├── UsageError                a command line that cannot work (the `twin`, `rapid`, `plc` commands)
+    ├── StationError              a station file or a model it names is wrong (names file and key)
+    ├── MechanismError            a gripper URDF cannot be turned into a mechanism
+    ├── SignalError               unknown signal name, or a write to an output
+    │   ├── SignalTypeError       a value of the wrong type for the signal (text for a number, NaN, ...)
+    │   └── SignalRangeError      a value outside the signal's range (never clamped)
+    ├── ObjectError               no such object (target, fixture, body) in the station
+    └── MotionError               the robot cannot reach a target (names the target)
 
-Above the core, `twin.modbus.register_map.MapError` and `plc_client.errors.PlcClientError` derive from
-`TwinError` too: `except TwinError` catches everything gripper-twin raises on purpose.
+Defined above the core, where they are found, and deriving from `TwinError` (the core imports none of them):
+`twin.exchange.SimulationFault` (the simulation stopped on an error), `twin.faults.FaultError` (a plant fault
+that cannot act), `twin.plugins.LoadError` (a station's plug-in), `twin.recording.RecordingError`,
+`twin.modbus.register_map.MapError`, `twin.opcua.security.SecurityError`, `twin.opcua.address_space.
+AddressSpaceError`, `twin.opcua.errors.AdvanceRefused`, `twin_app.campaign.spec.SpecError` (and its
+`ExpressionError`), `twin_app.campaign.scenario.ScenarioError`, `rapid_like.errors.RapidError` (FILE:LINE:COL),
+`structured_text.errors.StError` (FILE:LINE:COL), `plc_client.errors.PlcClientError`.
+
+The commands print one line for any of them (`one_line`) and exit 2 (a RAPID or ST program: its
+`headline()`, FILE:LINE:COL: error: ...). Argument checks of the programming interfaces (a negative drive
+limit, a scan cycle of 0 s) stay Python's ValueError, as Python's own functions do.
 """
 from __future__ import annotations
 
@@ -60,3 +71,26 @@ class MotionError(TwinError):
     def __init__(self, target: str, message: str):
         self.target = target
         super().__init__(f"target {target!r}: {message}")
+
+
+class UsageError(TwinError):
+    """A command line that cannot work: the command prints it as one line and exits with status 2."""
+
+
+class ObjectError(TwinError, KeyError):
+    """No such object (target, fixture, body) in a station. Also a KeyError: `Twin.object_pose` raised one
+    before it raised this, and a caller may still catch that."""
+
+    def __init__(self, name: str, message: str):
+        self.object = name
+        super().__init__(f"object {name!r}: {message}")
+
+    def __str__(self) -> str:  # KeyError's would quote the message
+        return self.args[0]
+
+
+def one_line(exc: BaseException) -> str:
+    """What a command prints for an error it stops on: one line (a program's error: FILE:LINE:COL: error: ...)."""
+    headline = getattr(exc, "headline", None)
+    text = headline() if callable(headline) else f"error: {exc}"
+    return text.strip().splitlines()[0] if text.strip() else "error"

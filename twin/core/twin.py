@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .errors import MotionError, SignalError, StationError
+from .errors import MotionError, ObjectError, SignalError, StationError
 from .gripper import Gripper
 from .mechanism import Mechanism, load_mechanism
 from .signal_table import IN_POSITION_TOLERANCE, MOVING_SPEED, twin_signals
@@ -324,7 +324,8 @@ class Twin:
     def object_pose(self, name: str) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """Position (m) and orientation (quaternion x, y, z, w) of a target or fixture."""
         if name not in self.world.body_ids:
-            raise KeyError(f"no object {name!r} in station {self.station.name!r}")
+            raise ObjectError(name, f"no such target or fixture in station {self.station.name!r} "
+                                    f"(it has: {', '.join(sorted(self.world.body_ids)) or 'none'})")
         return self.world.pose(name)
 
     def remove_object(self, name: str) -> None:
@@ -332,7 +333,7 @@ class Twin:
         next step, and writing it True puts the target back where the station placed it."""
         key = f"{name}.present"
         if key not in self._present:
-            raise KeyError(f"no target {name!r} in station {self.station.name!r}")
+            raise ObjectError(name, f"no such target in station {self.station.name!r}")
         self._present[key] = False
         self._place_targets()
         self._publish()

@@ -27,6 +27,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from twin.core.errors import TwinError
 from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
 
 from .units import Unit, unit_of
@@ -45,7 +46,7 @@ _INT32 = (-2**31, 2**31 - 1)
 _UINT32 = (0, 2**32 - 1)
 
 
-class AddressSpaceError(ValueError):
+class AddressSpaceError(TwinError):
     """The signal table cannot be served as an OPC UA address space (a name clash)."""
 
 

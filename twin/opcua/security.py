@@ -19,6 +19,8 @@ import socket
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from twin.core.errors import TwinError
+
 APPLICATION_URI = "urn:gripper-twin:server"
 NONE, SIGN, ENCRYPT = "none", "sign", "encrypt"
 # policy name -> asyncua's SecurityPolicyType member (asyncua is imported only when a server starts)
@@ -26,7 +28,7 @@ POLICIES = {NONE: "NoSecurity", SIGN: "Basic256Sha256_Sign", ENCRYPT: "Basic256S
 READER_ROLE_NAME = "reader:"  # User.name prefix of a read-only account
 
 
-class SecurityError(ValueError):
+class SecurityError(TwinError):
     """A security option that cannot work (a missing certificate file, a malformed account)."""
 
 

@@ -13,6 +13,8 @@ import math
 import operator
 from collections.abc import Mapping
 
+from twin.core.errors import TwinError
+
 FUNCTIONS = {"abs": abs, "min": min, "max": max, "round": round}
 CONSTANTS = {"true": True, "false": False, "True": True, "False": False, "none": None, "inf": math.inf}
 _BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
@@ -21,7 +23,7 @@ _COMPARE = {ast.Eq: operator.eq, ast.NotEq: operator.ne, ast.Lt: operator.lt, as
             ast.Gt: operator.gt, ast.GtE: operator.ge, ast.In: lambda a, b: a in b, ast.NotIn: lambda a, b: a not in b}
 
 
-class ExpressionError(ValueError):
+class ExpressionError(TwinError):
     """A condition that is not an allowed expression, or names a value that does not exist."""
 
 

@@ -15,6 +15,7 @@ from typing import Any
 from twin.plugins import load_object
 from .spec import Campaign, Scenario
 from twin.core.device import ObservingDevice
+from twin.core.errors import TwinError
 from twin.core.signals import ENGINEERING_UNITS
 
 UNIT_TO_MAP = {si: factor for si, (_, factor) in ENGINEERING_UNITS.items()}  # SI -> the map's units (mm, deg)
@@ -23,7 +24,7 @@ UNIT_TO_MAP = {si: factor for si, (_, factor) in ENGINEERING_UNITS.items()}  # S
 LAST_TIMING: dict[str, float] = {}
 
 
-class ScenarioError(Exception):
+class ScenarioError(TwinError):
     """A scenario that cannot run as written (a parameter that does not fit the station, a bad logic)."""
 
 

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from twin.core.errors import TwinError
+
 from .expressions import Expression, ExpressionError
 
 # -- the vocabulary -----------------------------------------------------------------------------------------
@@ -51,7 +53,7 @@ DEFAULT_TIMEOUT = 300.0  # s of wall time one scenario may take
 DEFAULT_MAX_TIME = 60.0  # s of simulated time
 
 
-class SpecError(ValueError):
+class SpecError(TwinError):
     """A mistake in a campaign file: names the file, the key and (where it applies) the scenario."""
 
     def __init__(self, file: str | Path, key: str, message: str, scenario: str | None = None):
