@@ -11,7 +11,8 @@ from the runtime's output:
     ! cmd: check                                   run `plc check FILE` instead of `plc run`
     ! error: 7:12 zero                             stderr is FILE:7:12: error: ... and its message holds
                                                    every word (a|b: either), any case; several `error:`
-                                                   lines: one stderr line each, in that order
+                                                   lines: one stderr line each, in that order;
+    ! error: parts/x.st:3:5 y                      an error in another file of the PLC (beside the file)
     ! exit: 70                                     the exit status (0 when not given)
     ! lreal: x,y                                   these names are LREAL: floats within 1e-12 (else 1e-6)
     ! exact: r                                     floats of these names compared exactly
@@ -151,7 +152,8 @@ def test_program(path: Path):
         lines = [line for line in err.splitlines() if line.strip()]
         assert len(lines) == len(exp["errors"]), f"want {len(exp['errors'])} error line(s), got:\n{err}"
         for line, (pos, words) in zip(lines, exp["errors"]):
-            assert line.startswith(f"{path}:{pos}: error: "), f"want {path}:{pos}: error: ..., got:\n{err}"
+            where = f"{path}:{pos}" if pos[0].isdigit() else f"{path.parent / pos}"  # parts/x.st:L:C
+            assert line.startswith(f"{where}: error: "), f"want {where}: error: ..., got:\n{err}"
             message = line.split(": error: ", 1)[1].lower()
             for word in words:
                 assert any(alt.lower() in message for alt in word.split("|")), f"{word!r} not in: {line}"
