@@ -179,3 +179,10 @@ GRIPPER = """PROGRAM gripper
   diGripDone := force > 100 * COUNTS_PER_N;
 END_PROGRAM
 """
+
+
+def test_the_ring_rigs_shipped_declarations_and_slave_device_are_what_twin_map_generates():
+    """stations/ring_rig_plc/io.st and mbconfig.cfg go with gripper.st to a real PLC: they must be current."""
+    assert (CELL / "io.st").read_text() == twin_map("--format", "st", "--program", "gripper").replace(
+        str(CELL), "stations/ring_rig_plc")
+    assert (CELL / "mbconfig.cfg").read_text() == twin_map("--format", "openplc")
