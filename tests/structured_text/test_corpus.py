@@ -34,6 +34,7 @@ from pathlib import Path
 import pytest
 
 CORPUS = Path(__file__).parent / "corpus"
+ROOT = Path(__file__).resolve().parents[2]  # the tree these tests belong to: its runtime is the one run
 FILES = sorted(p for p in CORPUS.rglob("*.st") if "parts" not in p.relative_to(CORPUS).parts)
 
 
@@ -88,7 +89,8 @@ def plc_command() -> list[str]:
 
 
 def run_plc(argv: list[str]) -> subprocess.CompletedProcess:
-    env = dict(os.environ)  # PYTHONPATH kept: a worktree's packages shadow the installed ones
+    env = dict(os.environ)  # PYTHONPATH kept, this tree first: its packages shadow any installed ones
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p)
     return subprocess.run([*plc_command(), *argv], capture_output=True, text=True, timeout=60, env=env)
 
 
