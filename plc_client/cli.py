@@ -349,6 +349,30 @@ def structured_text_command(argv: list[str]) -> list[str] | None:
     return None
 
 
+def check_with_map(argv: list[str]) -> int:
+    """`plc check FILE.st... --station DIR | --map FILE.json | --port P`: also every located variable against
+    the map's PLC layout, the ranges a Modbus master moves (`plc_client.st_io`)."""
+    p = Parser(prog="plc check", description="Check Structured Text files, and their located variables against "
+                                             "a register map's PLC layout.")
+    p.add_argument("files", nargs="+", metavar="FILE.st")
+    _globals(p, suppress=False)
+    args = p.parse_args([a for a in argv if a != "check"])
+    try:
+        if args.station:
+            rmap = RegisterMap.from_station(args.station, "plc")
+        else:
+            rmap = load_map(args)
+    except (ConnectionFailedError, ModbusExceptionError) as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_CONNECTION
+    except TwinError as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_USER
+    from .st_io import check_against_map
+
+    return check_against_map(args.files, rmap)
+
+
 def cmd_map(args) -> int:
     rmap = load_map(args)
     rows = [("name", "table", "address", "type", "unit", "range", "access")]
@@ -404,6 +428,8 @@ def main(argv: list[str] | None = None) -> int:
 
     argv = sys.argv[1:] if argv is None else argv
     st = structured_text_command(argv)
+    if st is not None and st[0] == "check" and any(a.split("=")[0] in ("--station", "--map", "--port") for a in argv):
+        return check_with_map(argv)
     if st is not None and not (len(st) == 2 and st[1] in ("-h", "--help") and st[0] == "run"):
         from structured_text.cli import check_main, run_main
         return (check_main if st[0] == "check" else run_main)(st[1:])

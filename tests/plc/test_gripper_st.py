@@ -110,25 +110,19 @@ def run_python(plant: Plant, robot: Robot, steps: int) -> list[tuple]:
 
 
 def run_st(plant: Plant, robot: Robot, steps: int, io: Path) -> list[tuple]:
+    from plc_client.st_io import LocatedBinding
     from structured_text.runtime import load
-    from twin.modbus.plc_export import located_variables
     from twin.modbus.register_map import build_map
 
     plc = load([CELL / "gripper.st", io])
-    located = located_variables(build_map(CELL, "plc"))
+    binding = LocatedBinding(build_map(CELL, "plc"))  # the input image word by word as the master hands it over
     trace, done = [], False
     for k in range(steps):
         values = {**plant.signals(), **robot.outputs(done), "sim.time_ms": round(k * DT * 1000)}
-        for v in located:  # the input image, word by word as the master would hand it over
-            if v.address.startswith("%I") and v.entry.name in values:
-                words = v.entry.encode(values[v.entry.name], engineering=True)
-                word = words[0] if v.word in ("", "HI") else words[1]
-                plc.write_located(v.address, bool(word) if v.entry.type == "bool" else word)
+        for address, word in binding.input_image(values).items():
+            plc.write_located(address, word)
         plc.scan(k * DT)
-        out = {}
-        for v in located:
-            if v.address.startswith("%Q"):
-                out[v.entry.name] = v.entry.decode([int(plc.read_located(v.address))])
+        out = binding.output_values({v.address: plc.read_located(v.address) for v in binding.outputs})
         for i, a in enumerate(AXES):
             plant.sp[i] = out[a]
         done = out["diGripDone"]

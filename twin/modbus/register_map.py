@@ -267,17 +267,17 @@ class RegisterMap:
 
     # -- loading --------------------------------------------------------------------------------------
     @classmethod
-    def from_station(cls, station) -> "RegisterMap":
+    def from_station(cls, station, layout: str = "") -> "RegisterMap":
         """The map `twin serve` serves for a station (a folder or a station.toml), from its static signal
         table: no physics, no RAPID. A station that cannot be read is a MapError too (naming its file and
         key, chained to the core's StationError), so a client has one error for "no map"."""
         try:
-            built = build_map(station)
+            built = build_map(station, layout)
         except MapError:
             raise
         except TwinError as exc:
             raise MapError(str(exc)) from exc
-        return cls(built.entries, built.station, source=f"station {built.station!r}")
+        return cls(built.entries, built.station, source=f"station {built.station!r}", layout=built.layout)
 
     @classmethod
     def from_json(cls, source: str | Path | Mapping | list) -> "RegisterMap":

@@ -1,0 +1,104 @@
+"""A Structured Text PLC's located variables and the twin's register map: the same device ranges a Modbus
+master PLC is configured with (`twin.modbus.register_map.master_ranges`, OpenPLC's convention), so what the
+ST PLC reads in the twin is what it reads on the real PLC.
+
+- `located_problems(program, rmap)`: `plc check FILE.st... --station DIR` (or `--map FILE.json`, or `--port P`:
+  the server's map): every located variable outside what the master moves, or of a type that cannot hold its
+  register's values, is an error at its declaration naming the signal (`twin.modbus.plc_export.located_problem`).
+- `LocatedBinding(rmap)`: the input image from signal values (engineering units, by entry name) word by word
+  as the master hands them over, and signal values from the output image.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from twin.modbus.plc_export import located_problem, located_variables
+from twin.modbus.register_map import PLC_LAYOUT, RegisterMap
+
+
+def _located_symbols(program):
+    """(symbol) of every located variable: the globals and the program instances' own."""
+    for s in program.globals.values():
+        if s.location is not None:
+            yield s
+    seen = set()
+    for inst in program.instances:
+        if id(inst.pou) in seen:
+            continue
+        seen.add(id(inst.pou))
+        for s in inst.pou.symbols.values():
+            if s.location is not None and not s.is_global:
+                yield s
+
+
+def located_problems(program, rmap: RegisterMap) -> list[str]:
+    """`FILE:LINE:COL: error: MESSAGE` per located variable that does not fit the map's device ranges."""
+    out = []
+    for s in _located_symbols(program):
+        area, size, indexes = s.location
+        problem = located_problem(rmap, area, size, tuple(indexes), str(s.type.name))
+        if problem is not None:
+            out.append(f"{s.span}: error: {s.name}: {problem}")
+    return out
+
+
+def check_against_map(files: list[str], rmap: RegisterMap) -> int:
+    """`plc check FILE.st... --station DIR`: the language's checks, then the located variables against the map.
+    Exit 0, 65 (an error: one line each on stderr), 66 (a file that cannot be read)."""
+    import sys
+
+    from structured_text.errors import StError
+    from structured_text.runtime import compile_files, read_source
+
+    try:
+        sources = {f: read_source(f) for f in files}
+    except (OSError, UnicodeDecodeError) as exc:
+        print(f"plc: error: cannot read {getattr(exc, 'filename', '') or ''}: {exc}", file=sys.stderr)
+        return 66
+    try:
+        compiled = compile_files(files, sources)
+    except StError as exc:
+        print(exc.headline(), file=sys.stderr)
+        return 65
+    problems = located_problems(compiled.program, rmap)
+    for line in problems:
+        print(line, file=sys.stderr)
+    return 65 if problems else 0
+
+
+class LocatedBinding:
+    """The located variables of a map's PLC layout, bound to its entries (OpenPLC's convention)."""
+
+    def __init__(self, rmap: RegisterMap):
+        if rmap.layout and rmap.layout != PLC_LAYOUT:
+            from twin.modbus.register_map import MapError
+
+            raise MapError("an ST PLC's located variables bind to the PLC layout (twin serve --layout plc)")
+        self.map = rmap
+        self.variables = located_variables(rmap)
+        self.inputs = [v for v in self.variables if v.address.startswith("%I")]
+        self.outputs = [v for v in self.variables if v.address.startswith("%Q")]
+        self.output_entries = list(dict.fromkeys(v.entry for v in self.outputs))
+        self.input_entries = list(dict.fromkeys(v.entry for v in self.inputs))
+
+    def input_image(self, values: Mapping[str, Any]) -> dict[str, int | bool]:
+        """Address -> word (or bit) from signal values in engineering units, by entry name."""
+        image = {}
+        for v in self.inputs:
+            if v.entry.name not in values:
+                continue
+            words = v.entry.encode(values[v.entry.name], engineering=True)
+            word = words[1] if v.word == "LO" else words[0]
+            image[v.address] = bool(word) if v.entry.type == "bool" else int(word)
+        return image
+
+    def output_values(self, image: Mapping[str, int | bool]) -> dict[str, Any]:
+        """Signal values in engineering units from the output image (address -> word or bit)."""
+        words: dict[str, list] = {}
+        for v in self.outputs:
+            w = image.get(v.address, 0)
+            slot = words.setdefault(v.entry.name, [0] * v.entry.count)
+            slot[1 if v.word == "LO" else 0] = int(w)
+        by_name = {e.name: e for e in self.output_entries}
+        return {name: by_name[name].decode(w) for name, w in words.items()}

@@ -1,0 +1,63 @@
+"""`plc check FILE.st --station DIR` (or `--map FILE.json`): the ST checks, then every located variable against
+the station's PLC layout, the ranges a Modbus master moves. An error names the file, line and column of the
+declaration, the variable and the signal at that address; exit 65."""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+CELL = ROOT / "stations" / "ring_rig_plc"
+pytestmark = pytest.mark.skipif(not (ROOT / "structured_text" / "runtime.py").exists(),
+                                reason="the ST runtime has not landed")
+
+BAD = """PROGRAM p
+  VAR
+    ok_bit AT %IX100.0 : BOOL;
+    setpoint AT %QW100 : INT;
+    past AT %IX103.2 : BOOL;
+    wide AT %ID100 : DINT;
+  END_VAR
+  VAR
+    x : INT;
+  END_VAR
+  x := 1;
+END_PROGRAM
+"""
+
+
+def plc(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "plc_client", *args], cwd=ROOT, capture_output=True, text=True)
+
+
+def test_located_variables_the_master_does_not_move_or_cannot_hold_are_errors_at_their_declaration(tmp_path):
+    src = tmp_path / "p.st"
+    src.write_text(BAD)
+    assert plc("check", str(src)).returncode == 0  # the language alone has nothing against them
+    out = plc("check", str(src), "--station", str(CELL))
+    assert out.returncode == 65
+    lines = out.stderr.strip().splitlines()
+    # the twin's map: L2 (holding register 0, 0 .. 441 mm in counts of 0.01) is 0 .. 44100 counts; the PLC layout
+    # has 26 discrete inputs (%IX100.0 .. %IX103.1)
+    assert re.match(rf"^{re.escape(str(src))}:4:5: error: setpoint: %QW100 is L2 .*44100.*UINT", lines[0]), lines
+    assert re.match(rf"^{re.escape(str(src))}:5:5: error: past: %IX103\.2: no signal there", lines[1]), lines
+    assert re.match(rf"^{re.escape(str(src))}:6:5: error: wide: %ID100: .*16-bit registers", lines[2]), lines
+    assert len(lines) == 3
+
+
+def test_the_shipped_gripper_plc_and_its_declarations_check_against_the_station(tmp_path):
+    out = plc("check", str(CELL / "gripper.st"), str(CELL / "io.st"), "--station", str(CELL))
+    assert out.returncode == 0, out.stderr
+    json_map = tmp_path / "map.json"
+    json_map.write_text(subprocess.run([sys.executable, "-m", "twin", "map", str(CELL), "--layout", "plc", "--format",
+                                        "json"], cwd=ROOT, capture_output=True, text=True, check=True).stdout)
+    out = plc("check", str(CELL / "gripper.st"), str(CELL / "io.st"), "--map", str(json_map))
+    assert out.returncode == 0, out.stderr
+    # the default layout's map is another: the same declarations do not fit it
+    json_map.write_text(subprocess.run([sys.executable, "-m", "twin", "map", str(CELL), "--format", "json"], cwd=ROOT,
+                                       capture_output=True, text=True, check=True).stdout)
+    assert plc("check", str(CELL / "gripper.st"), str(CELL / "io.st"), "--map", str(json_map)).returncode != 0
