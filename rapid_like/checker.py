@@ -30,16 +30,10 @@ _SIGNAL_PREFIXES = {"di": "DI", "do": "DO", "ai": "AI", "ao": "AO", "gi": "GI", 
 
 # Instructions accepted whose effect the simulation only approximates (`rapid check` lists each use).
 _APPROXIMATE = {
-    "velset": "the speed override and limit scale the motions' speed data; the robot's own dynamics are not modelled",
-    "accset": "acceleration is scaled in the station's motion only as a duration factor",
-    "confj": "the arm configuration is not checked (the simulated arm has one solution per target)",
-    "confl": "the arm configuration is not checked (the simulated arm has one solution per target)",
     "singarea": "singularities are not simulated",
     "pathresol": "the path resolution does not change the simulated motion",
     "cirpathmode": "the tool orientation along a circle is not changed by CirPathMode",
-    "gripload": "the payload is not simulated",
     "worldacclim": "acceleration limits are not simulated",
-    "pathacclim": "acceleration limits are not simulated",
     "stopmove": "motions are not queued: StopMove only holds the next motion until StartMove",
     "startmove": "motions are not queued: StartMove releases motions held by StopMove",
     "clearpath": "motions are not queued: there is no path to clear",
@@ -572,12 +566,11 @@ class Checker:
                          B.zone_names()), None)
             if any(a.optional and a.key == "conc" for a in s.args):
                 self.warn(s.span, f"{word} \\Conc: the program goes on at once and the next motion waits for "
-                                  f"this one; offline every motion ends at once")
-            if zone is not None and zone.value.text.lower() != "fine":
-                self.warn(zone.span, f"{word} with zone {zone.value.text}: in a station the program goes on when "
-                                     f"the TCP is within the zone and the next motion starts from there (the "
-                                     f"corner is cut from rest, not blended at speed; a MoveAbsJ stops at its "
-                                     f"point); offline every motion ends at once")
+                                  f"this one; offline without --station every motion ends at once")
+            if zone is not None and zone.value.text.lower() != "fine" and key not in ("movej", "movel", "movec",
+                                                                                        "moveabsj"):
+                self.warn(zone.span, f"{word} with zone {zone.value.text}: the motion stops at its point (the "
+                                     f"instruction acts there), as with fine")
 
     def signal_arg(self, name: str, p: n.Param, e: n.Expr, scope: dict[str, Sym]) -> None:
         want = SIGNAL_TYPES[p.type]

@@ -111,7 +111,11 @@ def build_parser() -> argparse.ArgumentParser:
                              "repeatable")
         sp.add_argument("--io", action="extend", nargs="+", default=[], metavar="TYPE:NAME,...",
                         help="configure I/O signals, e.g. DI:diPartHeld,AO:aoWidth (repeatable)")
-        sp.add_argument("--entry", default="main", help="routine to start from (default: main)")
+        sp.add_argument("--entry", default=None, help="routine to start from (default: main, or the station's entry)")
+        sp.add_argument("--station", metavar="DIR",
+                        help="a station (folder or station.toml): its controller's I/O configuration and, for a "
+                             "run, its robot (arm, tool, start pose, limits), moved by the cell's motion planner "
+                             "on the station's step; without modules, the station's own program")
     run.add_argument("--set", action="extend", nargs="+", default=[], metavar="NAME=VALUE[@T]",
                      help="set a signal at simulated time T seconds (default 0); repeatable")
     run.add_argument("--max-time", type=float, default=None, metavar="T",
@@ -169,6 +173,27 @@ def _main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(_program_first(argv))
     out, err = sys.stdout, sys.stderr
     paths = list(args.program)
+    station = None
+    if args.station:
+        from twin.core.errors import TwinError
+        from twin.core.station import load_station
+
+        try:
+            station = load_station(args.station)
+        except (TwinError, OSError) as e:
+            print(f"rapid: error: --station {args.station}: {e}", file=err)
+            return EX_USAGE
+        if station.controller is None:
+            print(f"rapid: error: --station {args.station}: the station has no [controller]", file=err)
+            return EX_USAGE
+        if not paths and not args.task:
+            paths = [str(station.controller.program), *(str(m) for m in station.controller.modules)]
+            if args.entry is None:
+                args.entry = station.controller.entry
+            if args.command == "run" and not args.answer:
+                args.answer = list(station.controller.answers)
+    if args.entry is None:
+        args.entry = "main"
     if args.task:
         if not Path(args.task).is_dir():
             print(f"{args.task}: error: --task needs a directory", file=err)
@@ -190,6 +215,11 @@ def _main(argv: list[str] | None = None) -> int:
         if args.command == "run" and args.cycles < 1:
             raise UsageError("--cycles must be >= 1")
         signals = parse_io(args.io)
+        if station is not None:
+            from .offline_cell import station_signals
+
+            configured = {s.name.lower() for s in signals}
+            signals += [s for s in station_signals(station) if s.name.lower() not in configured]
         changes = parse_set(args.set, signals) if args.command == "run" else []
         if args.command == "run":
             if args.max_time is not None and args.max_time < 0:
@@ -208,7 +238,7 @@ def _main(argv: list[str] | None = None) -> int:
             text = f"{first}: {text}"
         print(text, file=err)
 
-    infer = not args.io
+    infer = not args.io and station is None
     try:
         program = n.Task([parse(sources[p], p) for p in paths])
         if len(program.modules) == 1:
@@ -237,9 +267,15 @@ def _main(argv: list[str] | None = None) -> int:
             elif ev["type"] == "errlog":
                 out.write(f"[event log, {ev['level']}] {ev['header']}: {ev['reason']}\n")
 
+        host, grid = None, None
+        if station is not None:
+            from .offline_cell import OfflineStationHost
+
+            host, grid = OfflineStationHost(station, extra=[s for s in signals if s.name not in
+                                                            {i.name for i in station.controller.io}]), station.step
         outcome = run_offline(program, signals, changes, args.entry, args.max_time, args.step, on_event,
                               loop_budget=args.loop_budget, answers=args.answer, cycles=args.cycles,
-                              infer_signals=infer)
+                              infer_signals=infer, host=host, grid=grid)
     except RapidError as e:
         report(e)
         return EX_DATAERR

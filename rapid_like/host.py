@@ -8,6 +8,10 @@ through a `Host`:
     write_signal(name, value)      SetDO/Set/Reset/SetAO/SetGO/PulseDO edges (outputs only)
     start_motion(request) -> h     begin a MoveJ/MoveL/MoveC/MoveAbsJ; returns any handle
     motion_done(h) -> bool         asked every tick until True; then the program goes on
+    (optional) motion_ready(h)     a host that plans ahead: may the program go on past zone point h (its TCP
+                                   has reached the largest zone)? The program pointer runs one motion ahead
+    (optional) motion_wake(h, what) -> ns | None  when h is "ready" or its plan "end"s, for event-driven runs
+    (optional) corner_failure(h)   did zone point h become a stop point (its next motion came too late)?
     current_robtarget(tool, wobj)  for CRobT: the TCP of `tool` in `wobj`, a robtarget Record
     current_jointtarget()          for CJointT
     tp_write(text)                 a line for the FlexPendant (TPWrite)
@@ -34,8 +38,8 @@ Notes for a station binding (item 5):
   twin's grip output. The controller never scales anything.
 - `start_motion` receives targets in mm and quaternions [q1..q4] (q1 = w), in `request.wobj`'s
   user/object frame, for the TCP of `request.tool` (tframe in the flange frame); `motion_done` is
-  polled on every tick. Zones are not blended: every motion completes (like `fine`) before the
-  next instruction runs.
+  polled on every tick. A host with `motion_ready` queues the motion behind the ones under way and
+  blends zones (twin.core.planner); one without completes every motion (like `fine`).
 - Time: call `Controller.tick(now)` once per control step after applying the step's inputs; the
   program sees signal values as they are at `now`.
 """
@@ -82,6 +86,17 @@ class MotionRequest:
     tool_name: str = ""
     wobj_name: str = "wobj0"
     line: int = 0
+    # how the controller plans it (docs/rapid.md, "Motion"): \T (s, after VelSet), AccSet's (acc, ramp) in %,
+    # a stop point (fine or \Inpos), \Z (mm) instead of the zone's pzone_tcp, the payload's mass (kg: the
+    # tool's load and GripLoad, or \TLoad), configuration monitoring on (ConfJ\On for MoveJ, ConfL\On for
+    # MoveL/MoveC), PathAccLim's TCP acceleration limit (m/s^2)
+    time: float | None = None
+    acc: tuple[float, float] = (100.0, 100.0)
+    stop_point: bool = True
+    zone_size: float | None = None
+    load_kg: float = 0.0
+    conf: bool = False
+    path_acc: float | None = None
 
 
 @runtime_checkable

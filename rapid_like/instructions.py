@@ -294,19 +294,49 @@ class InstructionsMixin:
 
     i_break = i_stop
 
-    def _noop(self, s, arg, text, bound):
-        for k in bound:
-            arg(k)  # evaluate for errors
-        yield from ()
-
-    i_confj = i_confl = i_accset = _noop
-
     def i_velset(self, s, arg, text, bound):
-        """VelSet: later motions run at Override % of their programmed speed, at most Max mm/s."""
+        """VelSet: later motions run at Override % of their programmed speed (and take 100 / Override times a
+        \\T), the TCP at most Max mm/s."""
         override, vmax = arg("override"), arg("max")
         if override <= 0 or vmax <= 0:
             raise self.fail("VelSet: Override and Max must be > 0", s.span, "ERR_ARGVALERR")
         self.velset = (override, vmax)
+        yield from ()
+
+    def i_accset(self, s, arg, text, bound):
+        """AccSet Acc, Ramp: later motions accelerate at Acc % of the arm's limits, the acceleration rising at
+        Ramp % of its normal rate (the manual's range: Acc 1 to 100, Ramp 10 to 100)."""
+        acc, ramp = arg("acc"), arg("ramp")
+        arg("finepointramp")
+        if not 1 <= acc <= 100 or not 10 <= ramp <= 100:
+            raise self.fail(f"AccSet: Acc must be 1 to 100 and Ramp 10 to 100, not {fmt_num(acc)}, {fmt_num(ramp)}",
+                            s.span, "ERR_ARGVALERR")
+        self.accset = (float(acc), float(ramp))
+        yield from ()
+
+    def _conf(self, s, bound, which: str):
+        self.conf[which] = "off" not in bound  # \On (or no switch) turns monitoring on, \Off off
+        yield from ()
+
+    def i_confj(self, s, arg, text, bound):
+        yield from self._conf(s, bound, "j")
+
+    def i_confl(self, s, arg, text, bound):
+        yield from self._conf(s, bound, "l")
+
+    def i_gripload(self, s, arg, text, bound):
+        """GripLoad: the payload's mass counts in the motions' acceleration from now on (load0: none)."""
+        self.gripload = float(arg("load").fields["mass"])
+        yield from ()
+
+    def i_pathacclim(self, s, arg, text, bound):
+        """PathAccLim: the TCP's acceleration along the path at most AccMax (m/s^2) while AccLim is TRUE (the
+        deceleration limit is taken as the same bound: the planner's profiles are symmetric)."""
+        on, dec_on = arg("acclim"), arg("decellim")
+        limits = [v for flag, v in ((on, arg("accmax")), (dec_on, arg("decelmax"))) if flag and v is not None]
+        if any(v < 0.1 for v in limits):
+            raise self.fail("PathAccLim: AccMax and DecelMax must be at least 0.1 m/s2", s.span, "ERR_ARGVALERR")
+        self.path_acc = min(limits) if limits else None
         yield from ()
 
     def i_waitrob(self, s, arg, text, bound):
@@ -404,21 +434,43 @@ class InstructionsMixin:
         for k in ("id", "t", "z", "inpos", "tload"):  # accepted and ignored (builtins._MOVE_OPTS), but evaluated
             if k in B.INSTRUCTION_PARAMS[s.key]:
                 arg(k)
-        v = arg("v") if "v" in B.INSTRUCTION_PARAMS[s.key] else None
+        params = B.INSTRUCTION_PARAMS[s.key]
+        v = arg("v") if "v" in params else None
         if v is not None:  # \V: the TCP speed in mm/s, instead of the speeddata's v_tcp
             speed = speed.copy()
             speed.fields["v_tcp"] = v
-        velset = getattr(self, "velset", None)
-        if velset is not None and velset != (100.0, 5000.0):  # VelSet: override % and a limit in mm/s
+        override, vmax = self.velset
+        if (override, vmax) != (100.0, 5000.0):  # VelSet: override % of every speed, the TCP at most Max mm/s
             speed = speed.copy()
-            speed.fields["v_tcp"] = min(speed.fields["v_tcp"] * velset[0] / 100.0, velset[1])
+            f = speed.fields
+            f["v_tcp"] = min(f["v_tcp"] * override / 100.0, vmax)
+            for k in ("v_ori", "v_leax", "v_reax"):
+                f[k] = f[k] * override / 100.0
+        seconds = arg("t") if "t" in params else None
+        if seconds is not None:
+            if seconds <= 0:
+                raise self.fail(f"{instr} \\T must be > 0 s, not {fmt_num(seconds)}", bound["t"].value.span,
+                                "ERR_ARGVALERR")
+            seconds = seconds * 100.0 / override
+        zone_rec = arg("zone", self.predefined["fine"].value)  # (SearchL has none: it stops)
+        # the instructions that act at the point (MoveJDO, MoveLSync, TriggL, SearchL, ...) stop there
+        at_point = s.key not in ("movej", "movel", "movec", "moveabsj")
+        inpos = arg("inpos") if "inpos" in params else None
+        zsize = arg("z") if "z" in params else None
+        tload = arg("tload") if "tload" in params else None
+        tool = arg("tool")
+        load = float(tload.fields["mass"]) if tload is not None else (
+            float(tool.fields["tload"].fields["mass"]) + self.gripload)
+        conf = self.conf["j"] if instr == "MoveJ" else self.conf["l"] if instr in ("MoveL", "MoveC") else False
         while self.stop_move:  # StopMove holds the motion until StartMove (from a TRAP)
             yield from self.pause(Wait("signal", None, f"{instr} held by StopMove", s.span))
         req = MotionRequest(
-            instr=instr, target=target, via=via, speed=speed, zone=arg("zone"), tool=arg("tool"),
+            instr=instr, target=target, via=via, speed=speed, zone=zone_rec, tool=tool,
             wobj=arg("wobj", self.predefined["wobj0"].value), target_name=text(target_key),
             via_name=text("cirpoint"), speed_name=text("speed"), zone_name=text("zone"),
-            tool_name=text("tool"), wobj_name=text("wobj", "wobj0"), line=s.span.line)
+            tool_name=text("tool"), wobj_name=text("wobj", "wobj0"), line=s.span.line,
+            time=seconds, acc=self.accset, stop_point=bool(zone_rec.fields["finep"]) or inpos is not None or at_point,
+            zone_size=zsize, load_kg=load, conf=conf, path_acc=self.path_acc)
         ev = {"type": "move", "instr": instr, "to": _target_json(target)}
         if via is not None:
             ev["via"] = _target_json(via)
@@ -428,10 +480,27 @@ class InstructionsMixin:
             yield from self.pause(Wait("motion", None, f"{instr} {req.target_name} after the \\Conc motion", s.span))
         handle = self.host.start_motion(req)
         self.active_tool, self.active_wobj = req.tool, req.wobj
+        failed = getattr(self.host, "corner_failure", None)
+        if failed is not None and self.last_motion is not None and self.corner_warning and failed(self.last_motion):
+            self.emit({"type": "warning", "line": s.span.line,
+                       "message": f"corner path failure: the motion before {instr} {req.target_name} ends at its "
+                                  f"zone point as at a fine point (this motion came too late for a corner path)"})
+        self.last_motion = handle
         if arg("conc"):  # \Conc: the program goes on at once, the motion runs on
             self.concurrent = handle
             return
         self.concurrent = None
+        ready = getattr(self.host, "motion_ready", None)
+        if ready is not None:  # a planning host: the program pointer runs one motion ahead
+            wake = getattr(self.host, "motion_wake", lambda h, what: None)
+            what = f"{instr} {req.target_name}"
+            if not req.stop_point:
+                while not ready(handle):
+                    yield from self.pause(Wait("motion", wake(handle, "ready"), what, s.span))
+                return
+            while not self.host.motion_done(handle):
+                yield from self.pause(Wait("motion", wake(handle, "end"), what, s.span))
+            return
         zone = req.zone.fields
         in_zone = getattr(self.host, "motion_in_zone", None)
         radius = float(zone["pzone_tcp"]) if not zone["finep"] else 0.0

@@ -68,6 +68,16 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         self.files: dict[str, str] = {}  # files the program wrote (Open ... \\Write; Write), by path
         self.concurrent = None  # the handle of a \\Conc motion still running
         self.last_position: tuple | None = None  # the last Cartesian target (mm), for offline motion times
+        # motion settings (docs/rapid.md): AccSet (acc %, ramp %), VelSet (override %, max mm/s), ConfJ/ConfL
+        # monitoring, the GripLoad mass (kg), PathAccLim (m/s^2 or None), CornerPathWarning
+        self.accset = (100.0, 100.0)
+        self.velset = (100.0, 5000.0)
+        self.conf = {"j": False, "l": False}
+        self.gripload = 0.0
+        self.path_acc: float | None = None
+        self.corner_warning = True
+        self.last_motion = None  # the handle of the last motion handed to the host (its corner may fail)
+        self.hardware_noted: set[str] = set()  # hardware-only instructions already noted in the log
         self.predefined = {k: Cell(t, v, "CONST", k) for k, (t, v) in B.predefined_data().items()}
         self.active_tool = self.predefined["tool0"].value
         self.active_wobj = self.predefined["wobj0"].value

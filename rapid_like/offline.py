@@ -66,9 +66,14 @@ def run_offline(module: n.Module | n.Task, signals: list[SignalInfo], changes: l
                 entry: str = "main", max_time: float | None = None, step: float = DEFAULT_STEP,
                 on_event: Callable[[dict], None] | None = None,
                 default_limit: float = DEFAULT_TIME_LIMIT, loop_budget: int = DEFAULT_LOOP_BUDGET,
-                answers: list[str] | None = None, cycles: int = 1, infer_signals: bool = False) -> Outcome:
+                answers: list[str] | None = None, cycles: int = 1, infer_signals: bool = False,
+                host=None, grid: float | None = None) -> Outcome:
     """Run `module` from `entry` until it ends, fails or `max_time` passes. Raises CheckError for
     static errors (nothing has run then).
+
+    `host`: a host other than the in-memory one (a station's, offline_cell.py; its `bind_clock` gets the
+    controller's clock). `grid`: tick only at multiples of it (s), as a station's controller is ticked once
+    per simulation step, so waits end at the same ticks as in the cell.
 
     Without `max_time`, a program that waits for something nothing scheduled can change is a
     runtime error ("waits forever"), and one that keeps running ends at `default_limit`."""
@@ -84,11 +89,15 @@ def run_offline(module: n.Module | n.Task, signals: list[SignalInfo], changes: l
         from .checker import check
 
         signals += check(module, {s.name.lower(): s for s in signals}, infer_signals=True).inferred
-    host = InMemoryHost(signals)
+    if host is None:
+        host = InMemoryHost(signals)
     names = {s.name.lower(): s.name for s in signals}
     pending = sorted(((to_ns(c.t), i, c) for i, c in enumerate(changes)), key=lambda x: (x[0], x[1]))
-    ctl = Controller(module, host, entry, on_event=emit, step=step, loop_budget=loop_budget, answers=answers,
-                     cycles=cycles)
+    ctl = Controller(module, host, entry, on_event=emit, step=grid or step, loop_budget=loop_budget,
+                     answers=answers, cycles=cycles)
+    if hasattr(host, "bind_clock"):
+        host.bind_clock(lambda: ctl.now / NS)
+    grid_ns = to_ns(grid) if grid else None
     limit = None if max_time is None else to_ns(max_time)
     fallback = to_ns(default_limit)
 
@@ -133,6 +142,8 @@ def run_offline(module: n.Module | n.Task, signals: list[SignalInfo], changes: l
             ctl._fail(err)
             return Outcome("error", now / NS, err, host, events)
         nxt = max(min(times), now + 1)
+        if grid_ns:  # the next tick of the cell's controller at or after it
+            nxt = -(-nxt // grid_ns) * grid_ns
         end = limit if limit is not None else fallback
         if nxt > end:
             now = end

@@ -40,6 +40,8 @@ from .builtins import ERRORS
 from .controller import ERROR, RUNNING, WAITING, Controller, load_program, load_task
 from .errors import ExecError
 from .host import MotionRequest, SignalInfo
+from .interpreter import to_ns
+from .robot_motion import conf_of, speed_of, zone_of
 from .values import Record, record
 
 STATION_LOOP_BUDGET = 200  # time-less loop iterations per simulation step (see the module docstring)
@@ -87,8 +89,6 @@ class TwinHost:
         self.memory: dict[str, float] = {s.name: 0.0 for s in spec.io if not (s.drives or s.source)}
         self.outputs: dict[str, float] = {s.name: 0.0 for s in spec.io if s.drives}
         self.printed: list[str] = []
-        self._motion = 0
-        self._zone_target = None  # (tool, target position in m) of the running Cartesian motion
         self._active: tuple[Record | None, Record | None] = (None, None)  # tooldata, wobjdata of the last motion
 
     # -- signals --------------------------------------------------------------------------------------
@@ -121,42 +121,42 @@ class TwinHost:
 
     # -- robot ----------------------------------------------------------------------------------------
     def start_motion(self, request: MotionRequest) -> object:
-        """Drive the robot: the target is for the program's tooldata (its tframe) in its wobjdata."""
+        """Queue the motion with the robot's planner: the target is for the program's tooldata (its tframe) in its
+        wobjdata; it starts after the motion under way, or blends out of its zone (twin.core.planner)."""
         twin = self.twin
-        speed = request.speed.fields
-        v_tcp = float(speed["v_tcp"]) / 1000.0
-        v_ori = math.radians(float(speed["v_ori"]))
         name = request.target_name or request.instr
-        tool = _tframe(request.tool)
-        self._zone_target = None
+        robot = twin.station.robot
+        speed = speed_of(request, robot.payload_kg if robot is not None else None)
+        zone = zone_of(request)
         try:
             if request.instr == "MoveAbsJ":
                 q = [math.radians(float(v)) for v in request.target.fields["robax"].values()]
-                twin.move("MoveAbsJ", q, v_tcp, v_ori=v_ori, name=name)
+                handle = twin.move("MoveAbsJ", q, speed, name=name, zone=zone)
             else:
                 frame = _wobj_frame(request.wobj)
                 target = frame * _pose(request.target)
                 via = frame * _pose(request.via) if request.via is not None else None
-                twin.move(request.instr, target, v_tcp, v_ori=v_ori, via=via, name=name, tool=tool)
-                self._zone_target = (tool, target.position)
+                handle = twin.move(request.instr, target, speed, via=via, name=name, tool=_tframe(request.tool),
+                                   zone=zone, conf=conf_of(request))
         except MotionError as exc:
             raise HostError(str(exc), "ERR_ROBLIMIT") from None
         self._active = (request.tool, request.wobj)
-        self._motion += 1
-        return self._motion
+        return handle
 
     def motion_done(self, handle: object) -> bool:
-        return handle != self._motion or not self.twin.robot_busy
+        return self.twin.motion_done(handle)
 
-    def motion_in_zone(self, handle: object, radius_mm: float) -> bool:
-        """Is the TCP of a Cartesian motion within `radius_mm` of its target (or the motion over)? A
-        program moving with a zone goes on from there, and its next motion starts from where the robot
-        is: the corner is cut. A MoveAbsJ is a stop point."""
-        if self.motion_done(handle) or self._zone_target is None:
-            return self.motion_done(handle)
-        tool, goal = self._zone_target
-        here = self.twin.tcp_pose(tool).position
-        return math.dist([float(v) for v in here], [float(v) for v in goal]) * 1000.0 <= radius_mm
+    def motion_ready(self, handle: object) -> bool:
+        return self.twin.motion_ready(handle)
+
+    def corner_failure(self, handle: object) -> bool:
+        return self.twin.robot.corner_failure(handle)
+
+    def motion_wake(self, handle: object, what: str) -> int | None:
+        """When the program may go on past motion `handle` ("ready") or it ends ("end") on the plan (ns), for runners that jump from event to event."""
+        robot = self.twin.robot
+        t = robot.ready_time(handle) if what == "ready" else robot.end_time(handle)
+        return None if t is None else to_ns(t)
 
     def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
         """CRobT: the TCP of `tool` in `wobj`; without them, those of the last motion (the active ones), or

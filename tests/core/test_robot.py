@@ -174,7 +174,7 @@ def test_movej_duration_respects_every_axis_speed_limit(kin):
     assert np.all(np.abs(qd) <= vmax * (1 + 1e-9))
     assert np.allclose(traj.q(traj.duration), q1) and np.allclose(traj.q(0.0), HOME)
     half = movej(kin, HOME, None, q1, Speed(v_tcp=100.0, v_ori=100.0, joint_fraction=0.5), "half")
-    assert half.profile.cruise == pytest.approx(2 * traj.profile.cruise)
+    assert half.profile.rate == pytest.approx(traj.profile.rate / 2)  # half the axes' speed: half the rate
 
 
 def test_movej_to_a_pose_is_limited_by_tcp_speed(kin):
@@ -200,7 +200,8 @@ def test_moveabsj_beyond_a_joint_limit_is_refused(kin):
     with pytest.raises(MotionError, match=r"target 'park': would need joint_1 beyond its limit \(200\.0 deg"):
         moveabsj(HOME, np.radians([200, 0, 0, 0, 90, 0]), Speed(), kin.limits, "park")
     traj = moveabsj(HOME, np.radians([90, 0, 0, 0, 90, 0]), Speed(), kin.limits, "quarter")
-    assert traj.duration == pytest.approx(math.radians(90) / kin.limits[0].velocity + Speed().ramp)
+    v, a = kin.limits[0].velocity, kin.accel[0]  # a trapezoid at the axis's limits, and the jerk's ramp at most
+    assert math.radians(90) / v + v / a <= traj.duration <= math.radians(90) / v + v / a + 0.1
 
 
 def test_movec_follows_the_circle_and_refuses_three_points_on_a_line(kin):

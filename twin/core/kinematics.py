@@ -35,6 +35,8 @@ IK_FAIL_ORI = math.radians(0.1)
 #: Restart seeds when the seed fails: joint_1 turned towards the wrist centre, then joint_2..6 in degrees.
 RESTART_POSES = ((0, 0, 0, 90, 0), (30, 30, 0, 30, 0), (-20, -60, 0, 60, 0), (0, 0, 0, -60, 0), (20, 0, 180, 60, 0))
 RESTART_ITERATIONS = 15
+#: Without acceleration limits from the station, an axis reaches its top speed in this time (s).
+DEFAULT_ACCEL_TIME = 0.5
 
 
 @dataclass(frozen=True)
@@ -109,6 +111,9 @@ class ArmKinematics:
         self.lower = np.array([lim.lower for lim in self.limits])
         self.upper = np.array([lim.upper for lim in self.limits])
         self.max_velocity = np.array([lim.velocity for lim in self.limits])
+        #: each axis's acceleration limit (rad/s^2): a station's `[robot] accel_deg`, else top speed in
+        #: DEFAULT_ACCEL_TIME
+        self.accel = self.max_velocity / DEFAULT_ACCEL_TIME
         self.n = len(self.joints)
         # the wrist centre (joint_5's axis, on the forearm axis) seen from the flange, for IK restarts
         wrist_link = self.joints[-2] if self.n >= 2 else self.flange

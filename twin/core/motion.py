@@ -6,12 +6,16 @@ previous solution, so a path through an unreachable point, past a joint limit or
 configuration flip raises `MotionError` naming the target before the robot moves. Executing it is then
 only a lookup: `q(t)` and `qd(t)` for t in seconds since the motion started.
 
-Timing: a path is followed at constant speed with a smooth ramp at both ends (velocity rises as a half
-cosine over `Speed.ramp` seconds, shortened for short moves). The cruise time is the longest of
-path length / v_tcp, reorientation angle / v_ori and, for every axis, what its speed limit
-(`JointLimit.velocity` x `Speed.joint_fraction`) allows: like a real controller, a move that would
-need an axis faster than it can go is slowed down, not refused. The whole move runs at one speed, so a
-MoveL passing close to a wrist singularity (joint_5 near 0) becomes slow from start to end.
+Timing: every motion runs from rest to rest along its path, with a jerk-limited ("S-curve") speed profile
+(`Profile`): the path speed rises with the acceleration growing over RAMP_TIME to its limit, cruises and falls
+again. The cruise speed is the highest at which the TCP keeps to v_tcp, the tool to v_ori and every axis to
+its speed limit (`JointLimit.velocity` x `Speed.joint_fraction`) where it moves fastest along the path; the
+acceleration the highest at which every axis keeps to its acceleration limit (`ArmKinematics.accel`, a
+station's `[robot] accel_deg`) there, scaled by `Speed.acc` (AccSet, payload) and the jerk by `Speed.ramp`.
+Like a real controller, a move that would need an axis faster than it can go is slowed down, not refused;
+the whole move runs at one speed, so a MoveL passing close to a wrist singularity (joint_5 near 0) becomes
+slow from start to end. Motions that blend in a zone overlap in time (planner.py): each is still planned
+from rest to rest.
 """
 from __future__ import annotations
 
@@ -23,17 +27,16 @@ import numpy as np
 
 from .errors import MotionError
 from .geometry import Pose, slerp
-from .kinematics import ArmKinematics, JointLimit, check_limits
+from .kinematics import DEFAULT_ACCEL_TIME, ArmKinematics, JointLimit, check_limits
 
 #: Cartesian paths are solved at least every SAMPLE_STEP m and SAMPLE_ANGLE rad.
 SAMPLE_STEP = 0.005
 SAMPLE_ANGLE = math.radians(0.5)
 #: Between two neighbouring samples no axis may jump more than this (a configuration flip).
 MAX_JOINT_JUMP = math.radians(5.0)
-#: The TCP's peak acceleration (m/s^2): a fast move's ramp is lengthened to keep within it, as a controller
-#: limits a heavily loaded arm (a 0.2 s ramp to a MoveJ's 3.4 m/s would be 27 m/s^2, more than any gripper's
-#: friction holds a heavy part through).
-MAX_TCP_ACCELERATION = 10.0
+#: The acceleration rises to its limit (and falls from it) in this time (s) at AccSet's Ramp 100: the jerk limit
+#: is the acceleration limit / RAMP_TIME.
+RAMP_TIME = 0.1
 #: MoveC: the three points must be this far apart and not within 0.06 degrees of one line.
 MIN_CIRCLE_POINT_DISTANCE = 0.001
 
@@ -45,51 +48,99 @@ class Speed:
     v_tcp:          TCP speed along the path, m/s (RAPID speeddata v_tcp / 1000).
     v_ori:          reorientation speed of the tool, rad/s (RAPID v_ori; v1000 has 500 deg/s).
     joint_fraction: fraction of each axis's maximum speed (URDF `velocity`) a move may use, 0 to 1.
-    ramp:           time to reach full speed from standstill, s (and to stop).
+    acc:            fraction of the axes' acceleration limits (AccSet Acc / 100, times the payload's factor).
+    ramp:           fraction of the normal jerk: how fast the acceleration may rise (AccSet Ramp / 100).
+    time:           the move's duration in s (RAPID \\T) instead of v_tcp and v_ori (never faster than the axes).
+    tcp_acc:        the TCP's acceleration limit along the path, m/s^2 (PathAccLim), or None.
     """
 
     v_tcp: float = 1.0
     v_ori: float = math.radians(500.0)
     joint_fraction: float = 1.0
-    ramp: float = 0.2
+    acc: float = 1.0
+    ramp: float = 1.0
+    time: float | None = None
+    tcp_acc: float | None = None
 
     def check(self, name: str) -> None:
-        for field in ("v_tcp", "v_ori", "joint_fraction"):
+        for field in ("v_tcp", "v_ori", "joint_fraction", "acc", "ramp"):
             v = getattr(self, field)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise MotionError(name, f"speed {field} must be a positive number, not {v!r}")
         if self.joint_fraction > 1.0:
             raise MotionError(name, f"speed joint_fraction must be at most 1, not {self.joint_fraction!r}")
-        if not (math.isfinite(self.ramp) and self.ramp >= 0):
-            raise MotionError(name, f"speed ramp must be a non-negative number of seconds, not {self.ramp!r}")
+        for field in ("time", "tcp_acc"):
+            v = getattr(self, field)
+            if v is not None and not (math.isfinite(v) and v > 0):
+                raise MotionError(name, f"speed {field} must be a positive number, not {v!r}")
 
 
 class Profile:
-    """Path parameter s(t) from 0 to 1: half-cosine ramp up, constant speed 1/cruise, ramp down."""
+    """Path parameter s(t) from 0 to 1, from rest to rest: a jerk-limited ("S-curve") rise to the rate `rate`
+    (ds/dt), at most `accel` (d2s/dt2) with the acceleration changing at most `jerk` (d3s/dt3), a cruise, and the
+    mirror-image fall. A move too short to reach `rate` peaks lower. `time`: stretch the move to last that long
+    (a lower cruise rate), if it is not already slower."""
 
-    def __init__(self, cruise: float, ramp: float):
-        self.cruise = float(cruise)
-        self.ramp = min(float(ramp), self.cruise)
-        self.duration = self.cruise + self.ramp
-        self.rate = 1.0 / self.cruise if self.cruise > 0 else 0.0
+    def __init__(self, rate: float, accel: float = math.inf, jerk: float = math.inf, time: float | None = None):
+        self.accel, self.jerk = float(accel), float(jerk)
+        if not (rate > 0 and math.isfinite(rate)):
+            self.rate, self.ap, self.tj, self.tc, self.ta, self.duration = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            self.cruise = 0.0
+            return
+        u = float(rate)
+        if u * self._rise(u)[2] > 1.0:  # too short to reach the rate: the highest rate that fits
+            lo, hi = 0.0, u
+            for _ in range(60):
+                mid = (lo + hi) / 2
+                lo, hi = (mid, hi) if mid * self._rise(mid)[2] <= 1.0 else (lo, mid)
+            u = lo
+        if time is not None and 1.0 / u + self._rise(u)[2] < time:  # \T: slower, to take `time`
+            lo, hi = 0.0, u
+            for _ in range(60):
+                mid = (lo + hi) / 2
+                lo, hi = (mid, hi) if mid > 0 and 1.0 / mid + self._rise(mid)[2] > time else (lo, mid)
+            u = hi
+        self.rate = u
+        self.ap, self.tj, self.ta = self._rise(u)
+        self.tc = max(self.ta - 2 * self.tj, 0.0)
+        self.duration = 1.0 / u + self.ta
+        self.cruise = 1.0 / u - self.ta  # time at full rate
+
+    def _rise(self, u: float) -> tuple[float, float, float]:
+        """(peak acceleration, time of each jerk phase, whole rise time) of a rise from rest to rate u."""
+        a, j = self.accel, self.jerk
+        if not math.isfinite(a):
+            return math.inf, 0.0, 0.0
+        ap = min(a, math.sqrt(u * j)) if math.isfinite(j) else a
+        tj = ap / j if math.isfinite(j) else 0.0
+        return ap, tj, u / ap + tj
 
     def _up(self, t: float) -> tuple[float, float]:
-        ta, v = self.ramp, self.rate
-        if ta <= 0:
-            return v * t, v
-        return v * (t / 2 - ta / (2 * math.pi) * math.sin(math.pi * t / ta)), v * (1 - math.cos(math.pi * t / ta)) / 2
+        """(s, ds/dt) t seconds into the rise from rest."""
+        ap, tj, tc, j = self.ap, self.tj, self.tc, self.jerk
+        if not math.isfinite(ap):
+            return self.rate * t, self.rate
+        if t <= tj:
+            return j * t ** 3 / 6, j * t * t / 2
+        v1, x1 = ap * tj / 2, (j * tj ** 3 / 6 if tj > 0 else 0.0)
+        tau = t - tj
+        if tau <= tc:
+            return x1 + v1 * tau + ap * tau * tau / 2, v1 + ap * tau
+        v2, x2 = v1 + ap * tc, x1 + v1 * tc + ap * tc * tc / 2
+        tau = min(tau - tc, tj)
+        return x2 + v2 * tau + ap * tau * tau / 2 - j * tau ** 3 / 6, v2 + ap * tau - j * tau * tau / 2
 
     def s(self, t: float) -> tuple[float, float]:
         """(s, ds/dt) at time t."""
-        if self.cruise <= 0 or t >= self.duration:
+        if self.rate <= 0 or t >= self.duration:
             return 1.0, 0.0
         if t <= 0:
             return 0.0, 0.0
-        ta = self.ramp
+        ta = self.ta
         if t < ta:
             return self._up(t)
         if t <= self.duration - ta:
-            return self.rate * (ta / 2 + (t - ta)), self.rate
+            return self._up(ta)[0] + self.rate * (t - ta), self.rate
         s, v = self._up(self.duration - t)
         return 1.0 - s, v
 
@@ -104,7 +155,7 @@ class Trajectory:
 
     def __init__(self, kind: str, name: str, knots: np.ndarray, profile: Profile,
                  path: Callable[[float], Pose] | None = None, tcp_path_length: float = 0.0,
-                 s_knots: np.ndarray | None = None):
+                 s_knots: np.ndarray | None = None, kin: ArmKinematics | None = None):
         self.kind, self.name = kind, name
         self._knots = np.array(knots, dtype=float)  # shape (n + 1, axes): q at path parameter s_knots[i]
         self._n = len(self._knots) - 1
@@ -113,6 +164,7 @@ class Trajectory:
         self.duration = profile.duration
         self.path = path
         self.tcp_path_length = tcp_path_length
+        self.kin = kin  # (for the TCP along a blend; None: the knots are TCP positions themselves)
 
     @property
     def q_start(self) -> np.ndarray:
@@ -143,21 +195,49 @@ class Trajectory:
     def done(self, t: float) -> bool:
         return t >= self.duration
 
+    def tcp(self, q: np.ndarray) -> Pose:
+        """The TCP for joint positions q of this motion (its tool); a point motion's q is the TCP's position."""
+        return self.kin.fk(q) if self.kin is not None else Pose(q[:3])
+
     def __repr__(self) -> str:
         return f"Trajectory({self.kind} {self.name!r}, {self.duration:.3f} s)"
 
 
 # -- helpers -----------------------------------------------------------------------------------------
-def _joint_cruise(knots: np.ndarray, limits: Sequence[JointLimit], speed: Speed,
-                  s_knots: np.ndarray | None = None) -> float:
-    """Shortest cruise time (s runs at 1/cruise) in which no axis exceeds its speed limit."""
-    if len(knots) < 2:
-        return 0.0
-    if s_knots is None:
-        s_knots = np.linspace(0.0, 1.0, len(knots))
-    vmax = np.array([lim.velocity for lim in limits]) * speed.joint_fraction
-    dq_ds = np.abs(np.diff(knots, axis=0)) / np.diff(s_knots)[:, None]
-    return float(np.max(dq_ds.max(axis=0) / vmax))
+def default_accel(limits: Sequence[JointLimit]) -> np.ndarray:
+    """Each axis's acceleration limit (rad/s^2) when the station gives none: top speed in DEFAULT_ACCEL_TIME."""
+    return np.array([lim.velocity for lim in limits]) / DEFAULT_ACCEL_TIME
+
+
+def _timing(knots: np.ndarray, limits: Sequence[JointLimit], accel: Sequence[float] | None, speed: Speed,
+            length: float = 0.0, angle: float = 0.0, s_knots: np.ndarray | None = None) -> Profile:
+    """The profile of a path through joint-space `knots` (at path parameters s_knots, 0 to 1).
+
+    Its rate is the highest at which the TCP keeps to v_tcp over `length` (m), the tool to v_ori over `angle`
+    (rad), and no axis exceeds its speed limit where it moves fastest along the path; its acceleration the
+    highest at which no axis exceeds its acceleration limit there (x speed.acc), with the jerk that takes
+    RAMP_TIME to reach the full limit (x speed.ramp)."""
+    accel = default_accel(limits) if accel is None else np.asarray(accel, dtype=float)
+    rate, acc = math.inf, math.inf
+    if len(knots) >= 2:
+        if s_knots is None:
+            s_knots = np.linspace(0.0, 1.0, len(knots))
+        dq_ds = (np.abs(np.diff(knots, axis=0)) / np.diff(s_knots)[:, None]).max(axis=0)
+        vmax = np.array([lim.velocity for lim in limits]) * speed.joint_fraction
+        moving = dq_ds > 1e-12
+        if np.any(moving):
+            rate = float(np.min(vmax[moving] / dq_ds[moving]))
+            acc = float(np.min(accel[moving] / dq_ds[moving]))
+    if speed.time is None:
+        if length > 0:
+            rate = min(rate, speed.v_tcp / length)
+        if angle > 0:
+            rate = min(rate, speed.v_ori / angle)
+    if speed.tcp_acc is not None and length > 0:
+        acc = min(acc, speed.tcp_acc / length)
+    if not math.isfinite(rate):
+        return Profile(0.0)
+    return Profile(rate, acc * speed.acc, acc * speed.ramp / RAMP_TIME, speed.time)
 
 
 def _as_q(q: Iterable[float], n: int, name: str, what: str) -> np.ndarray:
@@ -179,22 +259,8 @@ def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callabl
     for i in range(1, n + 1):
         _sample(kin, path, (i - 1) / n, i / n, knots[-1], name, s_knots, knots, 0)
     knots_arr, s_arr = np.array(knots), np.array(s_knots)
-    cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots_arr, kin.limits, speed, s_arr))
-    return Trajectory(kind, name, knots_arr, _profile(cruise, speed, length), path, length, s_arr)
-
-
-def _profile(cruise: float, speed: Speed, tcp_per_s: float) -> Profile:
-    """The timing: `cruise` and the speed's ramp, both lengthened so that the half-cosine ramps keep the TCP within
-    MAX_TCP_ACCELERATION (their peak acceleration is pi/2 x peak speed / ramp). `tcp_per_s`: the TCP's fastest
-    travel per unit of the path parameter (its peak speed is that / cruise); a ramp longer than the cruise
-    stretches the cruise too."""
-    if cruise <= 0 or tcp_per_s <= 0:
-        return Profile(cruise, speed.ramp)
-    need = math.pi / 2 * tcp_per_s / MAX_TCP_ACCELERATION  # ramp x cruise needed
-    ramp = max(speed.ramp, need / cruise)
-    if ramp > cruise:  # a short, fast move: ramp up and straight down again, each as long as it must be
-        ramp = cruise = max(math.sqrt(need), min(speed.ramp, cruise))
-    return Profile(cruise, ramp)
+    profile = _timing(knots_arr, kin.limits, kin.accel, speed, length, angle, s_arr)
+    return Trajectory(kind, name, knots_arr, profile, path, length, s_arr, kin)
 
 
 def _solve_at(kin: ArmKinematics, path: Callable[[float], Pose], s: float, seed: np.ndarray, name: str) -> np.ndarray:
@@ -248,9 +314,8 @@ def movej(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose | None
     length = sum(a.distance(b) for a, b in zip(poses, poses[1:]))
     angle = sum(a.angle(b) for a, b in zip(poses, poses[1:]))
     knots = np.array([q0, q1])
-    cruise = max(length / speed.v_tcp, angle / speed.v_ori, _joint_cruise(knots, kin.limits, speed))
-    fastest = max((a.distance(b) for a, b in zip(poses, poses[1:])), default=0.0) * steps
-    return Trajectory("MoveJ", name, knots, _profile(cruise, speed, fastest), None, length)
+    return Trajectory("MoveJ", name, knots, _timing(knots, kin.limits, kin.accel, speed, length, angle), None,
+                      length, kin=kin)
 
 
 def moveabsj(q_start: Iterable[float], q_target: Iterable[float], speed: Speed = Speed(),
@@ -268,7 +333,7 @@ def moveabsj(q_start: Iterable[float], q_target: Iterable[float], speed: Speed =
     q1 = _as_q(q_target, n, name, "the target")
     check_limits(q1, joint_limits, name)
     knots = np.array([q0, q1])
-    return Trajectory("MoveAbsJ", name, knots, Profile(_joint_cruise(knots, joint_limits, speed), speed.ramp))
+    return Trajectory("MoveAbsJ", name, knots, _timing(knots, joint_limits, None, speed))
 
 
 def movel(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose, speed: Speed = Speed(),
@@ -322,3 +387,12 @@ def movec(kin: ArmKinematics, q_start: Iterable[float], via_pose: Pose, target_p
         return Pose(centre + radius * (math.cos(a) * u + math.sin(a) * w), slerp(start.orientation, end.orientation, s))
 
     return _cartesian("MoveC", kin, q0, path, radius * phi, start.angle(end), speed, name)
+
+
+def payload_factor(load_kg: float, rated_kg: float | None) -> float:
+    """How much of the arm's acceleration is left with a payload of `load_kg`: 1 / (1 + load / rated), so the
+    rated payload halves it (the axes' torque is limited; the load's inertia adds to the arm's own). Without a
+    rated payload (None) a load changes nothing."""
+    if not rated_kg or load_kg <= 0:
+        return 1.0
+    return 1.0 / (1.0 + load_kg / rated_kg)

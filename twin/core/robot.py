@@ -1,10 +1,12 @@
 """The robot in the physics world: drives an arm's joints along a trajectory, step by step.
 
-`Robot.update(t)` is called once per simulation step, before the physics steps from t to t + dt. It
-commands pybullet's POSITION_CONTROL towards where the trajectory will be at the end of the step
-(`q(t + dt)`, with `qd(t + dt)` as the velocity feed-forward), with the axes' URDF efforts as force
-limits. After the planned duration the robot keeps commanding the end point and stays busy until the
-TCP has settled there (within `settle_distance` and `settle_angle`), or `settle_timeout` has passed.
+`Robot.update(t)` is called before every physics (sub)step from t to t + dt. It commands pybullet's
+POSITION_CONTROL towards where the planned motion will be at the end of the step (`q(t + dt)`, with
+`qd(t + dt)` as the velocity feed-forward), with the axes' URDF efforts as force limits. The planned motion is
+a `MotionQueue` (planner.py): `start` replaces it with one motion, `queue` appends one that starts after the
+last (or blends out of its zone). After the last one's planned end the robot keeps commanding the end point
+and stays busy until the TCP has settled there (within `settle_distance` and `settle_angle`), or
+`settle_timeout` has passed.
 When idle it holds its last commanded position. The arm's joints are looked up by name, so the body may
 carry more joints (a gripper merged under the flange).
 """
@@ -20,6 +22,7 @@ from .errors import MotionError
 from .geometry import Pose
 from .kinematics import ARM_JOINTS, ArmKinematics
 from .motion import Trajectory
+from .planner import FINE, MotionQueue, Zone
 
 
 class Robot:
@@ -47,7 +50,9 @@ class Robot:
         self.dt = dt
         self.position_gain, self.velocity_gain = position_gain, velocity_gain
         self.settle_distance, self.settle_angle, self.settle_timeout = settle_distance, settle_angle, settle_timeout
-        self._traj: Trajectory | None = None
+        self._traj: Trajectory | None = None  # the last motion of the queue
+        self._queue: MotionQueue | None = None
+        self._handles = 0
         #: why the last motion ended without arriving (e.g. blocked by a collision), else None
         self.fault: str | None = None
         self._t0: float | None = 0.0
@@ -57,6 +62,7 @@ class Robot:
         self._motors = client.setJointMotorControlArray  # bound once: called at every physics substep
         self._joint_states = client.getJointStates
         self._hold = self.q
+        self._hold_for: Trajectory | None = None  # the last motion whose end self._hold is
         self._paused: np.ndarray | None = None  # while paused: where the arm holds
 
     # -- state --------------------------------------------------------------------------------------
@@ -92,7 +98,7 @@ class Robot:
             raise ValueError(f"expected {len(self.joints)} joint values")
         for j, v in zip(self.joints, q):
             self.client.resetJointState(self.body, j, float(v), 0.0)
-        self._traj, self._settled, self._hold, self.fault = None, True, q, None
+        self._traj, self._queue, self._settled, self._hold, self.fault = None, None, True, q, None
         self._command(q, np.zeros_like(q))
         self.check_kinematics()
 
@@ -116,19 +122,71 @@ class Robot:
                                        f"off by ({d[0]:.1f}, {d[1]:.1f}, {d[2]:.1f}) mm and "
                                        f"{math.degrees(physics.angle(planned)):.2f} deg (wrong base frame?)")
 
-    def start(self, trajectory: Trajectory, t: float | None = None) -> None:
+    def start(self, trajectory: Trajectory, t: float | None = None) -> int:
         """Run `trajectory` from simulated time t (s), or from the next `update` when t is None.
 
         It replaces any motion under way; build it from `robot.q` when the robot is at rest (a motion
-        started while another runs begins from standstill).
+        started while another runs begins from standstill). Returns the motion's handle.
         """
-        self._traj, self._settled, self.fault = trajectory, False, None
+        self._queue = MotionQueue(trajectory.q_start)
         self._t0 = None if t is None else float(t)
+        return self._append(trajectory, FINE, 0.0)
+
+    def queue(self, trajectory: Trajectory, zone: Zone, t: float) -> int:
+        """Append `trajectory` (planned from `plan_start()`) to the motions under way at simulated time t: it
+        starts when the last one ends, or blends out of its zone (planner.py). Returns the motion's handle."""
+        if self._queue is None or self._t0 is None or not self.busy(t):
+            self._queue = MotionQueue(trajectory.q_start)
+            self._t0 = float(t)
+            return self._append(trajectory, zone, 0.0)
+        return self._append(trajectory, zone, t - self._t0)
+
+    def _append(self, trajectory: Trajectory, zone: Zone, now: float) -> int:
+        self._handles += 1
+        self._queue.add(trajectory, zone, now, self._handles)
+        self._traj, self._settled, self.fault = trajectory, False, None
         self._end_tcp = self.kinematics.fk(trajectory.q_end) if self.kinematics is not None else None
+        return self._handles
+
+    def plan_start(self, t: float) -> np.ndarray:
+        """Where the next motion starts: the last queued motion's end while the robot is busy, else where it is."""
+        return self._queue.q_end if self._queue is not None and self.busy(t) else self.q
+
+    def _segment(self, handle: int):
+        return self._queue.find(handle) if self._queue is not None else None
+
+    def ready(self, handle: int, t: float) -> bool:
+        """May the program go on past motion `handle`: a zone point's TCP in its largest zone (planner.py)?"""
+        seg = self._segment(handle)
+        return seg is None or (self._t0 is not None and t - self._t0 >= seg.ready - 1e-9)
+
+    def done(self, handle: int, t: float) -> bool:
+        """Is motion `handle` over: the robot in position at its end, or gone on into the next motion?"""
+        seg = self._segment(handle)
+        if seg is None:
+            return True
+        if seg is self._queue.last:
+            return not self.busy(t)
+        return self._t0 is not None and t - self._t0 >= seg.end
+
+    def corner_failure(self, handle: int) -> bool:
+        """Did zone point `handle` become a stop point because its next motion came too late?"""
+        seg = self._segment(handle)
+        return seg is not None and seg.corner_failure
+
+    def ready_time(self, handle: int) -> float | None:
+        """The simulated time the program may go on past motion `handle` (`ready`), None if unknown."""
+        seg = self._segment(handle)
+        return None if seg is None or self._t0 is None else self._t0 + seg.ready
+
+    def end_time(self, handle: int) -> float | None:
+        """The simulated time motion `handle`'s plan ends, None if unknown."""
+        seg = self._segment(handle)
+        return None if seg is None or self._t0 is None else self._t0 + seg.end
 
     def stop(self) -> None:
         """Stop following the trajectory and hold where the arm is now."""
-        self._traj, self._settled, self._hold = None, True, self.q
+        self._traj, self._queue, self._settled, self._hold = None, None, True, self.q
 
     def pause(self, paused: bool = True) -> None:
         """A robot stop (protective stop, feed hold): the arm holds where it is and a motion under way waits,
@@ -155,16 +213,17 @@ class Robot:
         if self._t0 is None:
             return True
         tau = t - self._t0
-        if tau < self._traj.duration:
+        end = self._queue.end
+        if tau < end:
             return True
         if self._in_position():
             self._settled = True
-        elif tau >= self._traj.duration + self.settle_timeout:
+        elif tau >= end + self.settle_timeout:
             self._settled = True
             off = self.tcp_pose().distance(self._end_tcp) * 1000 if self.kinematics is not None else float("nan")
             self.fault = (f"target {self._traj.name!r}: not reached {self.settle_timeout:g} s after the motion's end "
                           f"(TCP {off:.1f} mm away; blocked?)")
-            self._traj, self._hold = None, self.q  # stop pushing: hold where it got to
+            self._traj, self._queue, self._hold = None, None, self.q  # stop pushing: hold where it got to
         return not self._settled
 
     def _in_position(self) -> bool:
@@ -187,11 +246,13 @@ class Robot:
         if self._t0 is None:
             self._t0 = float(t)
         tau = t - self._t0 + self.dt
-        if tau >= traj.duration:
-            self._hold = traj.q_end
+        queue = self._queue
+        if tau >= queue.end:
+            if self._hold_for is not traj:
+                self._hold, self._hold_for = queue.q(queue.end), traj
             self._command_hold(self._hold)
         else:
-            self._command(traj.q(tau), traj.qd(tau))
+            self._command(queue.q(tau), queue.qd(tau))
 
     def _command_hold(self, q: np.ndarray) -> None:
         """Hold q: commanded once (the motors keep their command), not again at every substep."""

@@ -104,6 +104,8 @@ class RobotSpec:
     home_deg: tuple[float, ...]
     flange_link: str = "flange"
     joints: tuple[str, ...] = ARM_JOINTS
+    accel_deg: tuple[float, ...] | None = None  # each axis's acceleration limit, deg/s^2 (None: kinematics' default)
+    payload_kg: float | None = None  # the rated payload: a load of this mass halves the accelerations
 
 
 @dataclass(frozen=True)
@@ -382,10 +384,17 @@ def load_station(path: str | Path) -> Station:
             raise rr.error("joints", f"must be a list of joint names (strings), not {jn!r}")
         if len(set(jn)) != len(jn):
             raise rr.error("joints", f"names a joint twice: {jn!r}")
+        accel = rr.get("accel_deg", list, None)
+        if accel is not None and (not _all_numbers(accel) or any(v <= 0 for v in accel)):
+            raise rr.error("accel_deg", f"must be a list of positive numbers (deg/s^2), not {accel!r}")
         robot = RobotSpec(rr.path_to("urdf"), _placement_key(rr, "base"), tuple(float(v) for v in home),
-                          rr.get("flange_link", str, "flange"), tuple(jn))
+                          rr.get("flange_link", str, "flange"), tuple(jn),
+                          None if accel is None else tuple(float(v) for v in accel),
+                          rr.number("payload_kg", None, positive=True))
         if len(robot.home_deg) != len(robot.joints):
             raise rr.error("home_deg", f"needs one value per joint ({len(robot.joints)}), has {len(robot.home_deg)}")
+        if robot.accel_deg is not None and len(robot.accel_deg) != len(robot.joints):
+            raise rr.error("accel_deg", f"needs one value per joint ({len(robot.joints)}), has {len(robot.accel_deg)}")
         _check_robot_urdf(file, robot, given=rr.has("joints"))
         tr = rr.sub("targets", required=False)
         if tr is not None:

@@ -83,6 +83,10 @@ class Twin:
                                                 joint_names=st.robot.joints)
             except MotionError as exc:  # load_station checks names; what is left is the joints' order
                 raise StationError(str(st.file), "robot.joints", str(exc).split(": ", 1)[-1]) from None
+            if st.robot.accel_deg is not None:
+                import numpy as np
+
+                self.kinematics.accel = np.radians(st.robot.accel_deg)
             self.robot = Robot(self.world.client, self.world.machine,
                                tuple(ROBOT_PREFIX + j for j in st.robot.joints), self.kinematics)
             self.robot.reset([math.radians(a) for a in st.robot.home_deg])
@@ -249,17 +253,21 @@ class Twin:
             raise MotionError(name, f"no such robot target in station {self.station.name!r} (targets: {known})")
         return Pose.from_xyz_rpy(placement.xyz, placement.rpy)
 
-    def move(self, instr: str, target, speed: float = 1.0, *, v_ori: float | None = None, via=None,
-             name: str | None = None, tool=None) -> None:
+    def move(self, instr: str, target, speed=1.0, *, v_ori: float | None = None, via=None,
+             name: str | None = None, tool=None, zone=None, conf=None) -> int:
         """Start a motion from where the robot is now; it runs over the next steps (see `robot_busy`).
 
         `instr` is MoveJ, MoveL, MoveC (through `via`) or MoveAbsJ (target: joint angles in rad). A
-        target is a Pose or the name of a station target; `speed` is the TCP speed in m/s, `v_ori` the
-        reorientation speed in rad/s. `tool`: the TCP in the flange frame for this motion (a Pose; default
-        the station's `tcp`). The whole path is checked before the robot moves: a target it cannot reach
-        raises MotionError naming the target.
+        target is a Pose or the name of a station target; `speed` is the TCP speed in m/s (or a
+        `motion.Speed`), `v_ori` the reorientation speed in rad/s. `tool`: the TCP in the flange frame for
+        this motion (a Pose; default the station's `tcp`). With a `zone` (planner.Zone) the motion is queued
+        instead: it starts from the last queued motion's end, after it or blending out of its zone. The whole
+        path is checked before the robot moves: a target it cannot reach raises MotionError naming the
+        target (and, with `conf` = RAPID's (cf1, cf4, cf6), one it reaches in another configuration).
+        Returns the motion's handle (`motion_ready`, `motion_done`).
         """
         from . import motion
+        from .planner import plan_motion
 
         if self.robot is None:
             raise MotionError(name or str(target), f"station {self.station.name!r} has no robot")
@@ -269,21 +277,24 @@ class Twin:
         if isinstance(via, str):
             via = self.target(via)
         name = name or instr
-        speed_spec = motion.Speed(v_tcp=speed, v_ori=v_ori) if v_ori is not None else motion.Speed(v_tcp=speed)
-        q0 = self.robot.q
-        kin = self.kinematics if tool is None else self.kinematics.with_tool(tool)
-        if instr == "MoveJ":
-            traj = motion.movej(kin, q0, target, None, speed_spec, name)
-        elif instr == "MoveL":
-            traj = motion.movel(kin, q0, target, speed_spec, name)
-        elif instr == "MoveC":
-            traj = motion.movec(kin, q0, via, target, speed_spec, name)
-        elif instr == "MoveAbsJ":
-            traj = motion.moveabsj(q0, target, speed_spec, kin.limits, name)
+        if isinstance(speed, motion.Speed):
+            speed_spec = speed
         else:
-            raise MotionError(name, f"unknown motion instruction {instr!r}")
-        self.robot.start(traj, self.time)
+            speed_spec = motion.Speed(v_tcp=speed, v_ori=v_ori) if v_ori is not None else motion.Speed(v_tcp=speed)
+        q0 = self.robot.q if zone is None else self.robot.plan_start(self.time)
+        kin = self.kinematics if tool is None else self.kinematics.with_tool(tool)
+        traj = plan_motion(kin, instr, q0, target, speed_spec, via, name, conf)
+        handle = self.robot.start(traj, self.time) if zone is None else self.robot.queue(traj, zone, self.time)
         self._publish()
+        return handle
+
+    def motion_ready(self, handle: int) -> bool:
+        """May a program go on past motion `handle` (a zone point's TCP in its largest zone, see planner.py)?"""
+        return self.robot.ready(handle, self.time)
+
+    def motion_done(self, handle: int) -> bool:
+        """Is motion `handle` over (in position at its end, or gone on into the next motion)?"""
+        return self.robot.done(handle, self.time)
 
     @property
     def robot_busy(self) -> bool:

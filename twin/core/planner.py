@@ -1,0 +1,314 @@
+"""The motion queue: motions handed to the robot ahead of time, blended in their zones as a controller plans them.
+
+RAPID's program pointer runs ahead of the robot: a motion to a zone point is handed over while the motion
+before it still runs, so the path planner knows where the robot goes next before it reaches the point.
+`MotionQueue` keeps those motions on the robot's motion clock (seconds). Each is a rest-to-rest
+`Trajectory` (motion.py) planned from the previous one's *programmed* end; where the previous one ends in a
+zone, the new one starts while the previous one is still running, when its TCP enters the zone, and the two
+overlap in joint space:
+
+    q(t) = q_start + sum over motions of (q_i(t - start_i) - q_i(0))
+
+(each q_i held at its ends outside its own time). Where two straight moves meet, the TCP leaves the first
+line at the zone's edge, cuts the corner and joins the second line within the zone; the speed never falls
+to zero, because the second motion speeds up while the first one slows down.
+
+The zone (RAPID zonedata): the corner path starts when the TCP is within `Zone.tcp` (pzone_tcp) of the
+programmed point and, for a reorientation, the tool within `Zone.angle` (zone_ori) of its programmed
+orientation. As on the controller, both are reduced to half the distance (and half the reorientation) to the
+neighbouring programmed points, so two corners never overlap. The start of the overlap is then delayed (by
+bisection) until the whole corner path stays within the zone's radius of the point: the path in a zone stays
+in the zone. A zone point whose next motion is not known when the TCP reaches the zone becomes a stop point
+(RAPID's "corner path failure"); `Segment.corner_failure` says so. The program goes on past a zone point's
+instruction when the TCP reaches the largest of its zones (`Segment.ready`), "some time before" the corner as
+the RAPID manual puts it, so the next motion is known when the corner path starts. `Zone.ori`, `Zone.eax`, `Zone.leax` and
+`Zone.reax` (pzone_ori, pzone_eax, zone_leax, zone_reax) are kept: the twin has no external axes and blends
+orientation and position over one corner.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .motion import Trajectory
+
+#: zone entry found to this time (s)
+ENTRY_RESOLUTION = 1e-4
+#: a reorientation smaller than this (rad) does not count for zone_ori
+MIN_TURN = 1e-4
+#: a next motion this late (s) after the TCP entered the zone still gets a corner path, from where the TCP is
+#: (a controller ticked at its step sees the zone's edge up to a step late)
+LATE = 0.025
+#: samples of the corner path checked against the zone
+CORNER_SAMPLES = 16
+
+
+@dataclass(frozen=True)
+class Zone:
+    """Where a motion may leave its programmed end point (RAPID zonedata, SI units); a stop point if `fine`.
+
+    tcp: pzone_tcp (m); ori: pzone_ori (m); eax: pzone_eax (m); angle: zone_ori (rad); leax: zone_leax (m);
+    reax: zone_reax (rad)."""
+
+    fine: bool = True
+    tcp: float = 0.0
+    ori: float = 0.0
+    eax: float = 0.0
+    angle: float = 0.0
+    leax: float = 0.0
+    reax: float = 0.0
+
+
+FINE = Zone()
+
+
+class Segment:
+    """One motion in the queue: its trajectory and zone, and when it starts on the motion clock."""
+
+    def __init__(self, handle: int, traj: Trajectory, zone: Zone, start: float):
+        self.handle, self.traj, self.zone, self.start = handle, traj, zone, start
+        self.point = traj.tcp(traj.q_end)  # the programmed point (the TCP at the end)
+        self.q0 = traj.q_start
+        self.ready = start  # when the program may go on past this motion (its largest zone reached)
+        self.corner_failure = False  # a zone point that became a stop point: its next motion came too late
+        self.radius = 0.0  # the zone's radius as reduced for its neighbours (m), once its corner is planned
+
+    @property
+    def end(self) -> float:
+        return self.start + self.traj.duration
+
+    def delta(self, t: float) -> np.ndarray:
+        return self.traj.q(t - self.start) - self.q0
+
+    def __repr__(self) -> str:
+        return f"Segment({self.handle}, {self.traj!r}, start {self.start:.3f})"
+
+
+class MotionQueue:
+    """Motions on the robot's motion clock, overlapping where they blend; see the module docstring."""
+
+    def __init__(self, q: np.ndarray):
+        self.q_base = np.array(q, dtype=float)  # where the first kept segment starts
+        self.segments: list[Segment] = []
+
+    @property
+    def end(self) -> float:
+        """When the last motion ends (0 when empty)."""
+        return max((s.end for s in self.segments), default=0.0)
+
+    @property
+    def q_end(self) -> np.ndarray:
+        """The last motion's programmed end (where a new motion is planned from)."""
+        return self.segments[-1].traj.q_end if self.segments else self.q_base.copy()
+
+    @property
+    def last(self) -> Segment | None:
+        return self.segments[-1] if self.segments else None
+
+    def find(self, handle: int) -> Segment | None:
+        return next((s for s in self.segments if s.handle == handle), None)
+
+    def add(self, traj: Trajectory, zone: Zone, now: float, handle: int = 0) -> Segment:
+        """Append `traj` (planned from `q_end`), starting at `now` at the earliest: after the last motion if that
+        ends at a stop point, or at its corner if it ends in a zone and its TCP has not passed the zone's edge."""
+        self._prune(now)
+        prev = self.last
+        start = now
+        if prev is not None and prev.end > now:
+            start = prev.end
+            if not prev.zone.fine:
+                corner = self._corner(prev, traj, now)
+                if corner is None:
+                    prev.corner_failure = True
+                else:
+                    start = corner
+        seg = Segment(handle, traj, zone, start)
+        seg.ready = start
+        if not zone.fine:  # the program goes on as the TCP reaches the largest zone
+            largest = min(max(zone.tcp, zone.ori, zone.eax), traj.tcp(traj.q_start).distance(seg.point) / 2)
+            if largest > 1e-6:
+                seg.ready = start + self._entry(traj, seg.point, largest, math.inf)
+        self.segments.append(seg)
+        return seg
+
+    def _prune(self, now: float) -> None:
+        """Forget motions over before `now` (their end becomes the base), keeping the last one."""
+        while len(self.segments) > 1 and self.segments[0].end <= now and self.segments[1].start <= now:
+            first = self.segments.pop(0)
+            self.q_base = self.q_base + first.traj.q_end - first.q0
+
+    def q(self, t: float) -> np.ndarray:
+        out = self.q_base.copy()
+        for s in self.segments:
+            if t > s.start:
+                out += s.delta(t)
+        return out
+
+    def qd(self, t: float) -> np.ndarray:
+        out = np.zeros_like(self.q_base)
+        for s in self.segments:
+            if s.start < t < s.end:
+                out += s.traj.qd(t - s.start)
+        return out
+
+    # -- corners ------------------------------------------------------------------------------------
+    def _corner(self, prev: Segment, nxt: Trajectory, now: float) -> float | None:
+        """When `nxt` starts to blend out of `prev`'s zone, or None when the TCP is already past the zone's edge
+        (or the zone shrinks to nothing: a stop point)."""
+        traj, point = prev.traj, prev.point
+        before = traj.tcp(traj.q_start)
+        after = nxt.tcp(nxt.q_end)
+        radius = min(prev.zone.tcp, before.distance(point) / 2, point.distance(after) / 2)
+        angle = math.inf
+        turns = [a for a in (before.angle(point), point.angle(after)) if a > MIN_TURN]
+        if prev.zone.angle > 0 and turns:
+            angle = min([prev.zone.angle] + [a / 2 for a in turns])
+        if radius <= 1e-6 or angle <= MIN_TURN:
+            return prev.end  # nothing left of the zone: a stop point, no failure
+        prev.radius = radius
+
+        first = prev.start + self._entry(traj, point, radius, angle)
+        if first < now - LATE:
+            return None  # the TCP has entered the zone already: too late for a corner path
+        first = max(first, now)
+        # the corner path must stay within the zone: start later (less overlap) until it does
+        if self._within(prev, nxt, first, point, radius):
+            return first
+        lo, hi = first, prev.end
+        for _ in range(12):
+            mid = (lo + hi) / 2
+            lo, hi = (lo, mid) if self._within(prev, nxt, mid, point, radius) else (mid, hi)
+        return hi
+
+    @staticmethod
+    def _entry(traj: Trajectory, point, radius: float, angle: float) -> float:
+        """When (s into traj) its TCP enters the zone of `radius` (and `angle`) around `point` for good: the last
+        time it is outside, searched back from the end, then bisected."""
+        def inside(t: float) -> bool:
+            pose = traj.tcp(traj.q(t))
+            return pose.distance(point) <= radius and (not math.isfinite(angle) or pose.angle(point) <= angle)
+
+        d = traj.duration
+        lo, step = d, max(d / 64, 0.005)
+        while lo > 0 and inside(lo):
+            lo = max(lo - step, 0.0)
+        if inside(lo):
+            return 0.0
+        hi = min(lo + step, d)
+        while hi - lo > ENTRY_RESOLUTION:
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if not inside(mid) else (lo, mid)
+        return hi
+
+    @staticmethod
+    def _within(prev: Segment, nxt: Trajectory, start: float, point, radius: float) -> bool:
+        """Does the TCP of prev + nxt (started at `start`) stay within `radius` of `point` while they overlap?"""
+        q_end = prev.traj.q_end
+        for t in np.linspace(start, prev.end, CORNER_SAMPLES + 1)[1:-1]:
+            q = prev.traj.q(t - prev.start) + (nxt.q(t - start) - q_end)
+            if nxt.tcp(q).distance(point) > radius * (1 + 1e-6) + 1e-6:
+                return False
+        return True
+
+
+# -- planning one motion ---------------------------------------------------------------------------------
+def configuration(q: np.ndarray) -> tuple[int, int, int]:
+    """RAPID's robconf cf1, cf4, cf6: the quadrants of axes 1, 4 and 6 (0 for 0 to 90 deg, -1 for -90 to 0, ...)."""
+    return tuple(int(math.floor(math.degrees(float(q[i])) / 90.0 + 1e-9)) for i in (0, 3, 5))  # type: ignore
+
+
+def plan_motion(kin, instr: str, q0: np.ndarray, target, speed, via=None, name: str = "",
+                conf: tuple[int, int, int] | None = None) -> Trajectory:
+    """The trajectory of one motion instruction from q0: MoveJ, MoveL, MoveC (through `via`) to a TCP Pose of
+    `kin`'s tool, or MoveAbsJ to joint angles (rad). With `conf` (cf1, cf4, cf6; configuration monitoring on) a
+    MoveJ seeks that configuration and any motion ending in another one is refused (MotionError)."""
+    from . import motion
+    from .errors import MotionError
+
+    name = name or instr
+    if instr == "MoveJ":
+        traj = motion.movej(kin, q0, target, None, speed, name)
+        if conf is not None and configuration(traj.q_end) != tuple(conf):
+            seed = np.array(q0, dtype=float)
+            for i, c in zip((0, 3, 5), conf):
+                seed[i] = math.radians(90.0 * c + 45.0)
+            try:
+                q1 = kin.ik(target, seed, name)
+                traj = motion.movej(kin, q0, None, q1, speed, name)
+            except MotionError:
+                pass
+    elif instr == "MoveL":
+        traj = motion.movel(kin, q0, target, speed, name)
+    elif instr == "MoveC":
+        traj = motion.movec(kin, q0, via, target, speed, name)
+    elif instr == "MoveAbsJ":
+        traj = motion.moveabsj(q0, target, speed, kin.limits, name, kin)
+    else:
+        raise MotionError(name, f"unknown motion instruction {instr!r}")
+    if conf is not None and instr != "MoveAbsJ" and configuration(traj.q_end) != tuple(conf):
+        got = configuration(traj.q_end)
+        raise MotionError(name, f"configuration [{conf[0]}, {conf[1]}, *, {conf[2]}] cannot be reached "
+                                f"(the arm gets there as [{got[0]}, {got[1]}, *, {got[2]}]; configuration "
+                                f"monitoring is on)")
+    return traj
+
+
+class KinematicRobot:
+    """The motion queue on a clock without physics (offline runs): the robot is exactly where the plan says, at
+    rest once its last motion's plan is over. Same interface as `robot.Robot` for queueing and asking."""
+
+    def __init__(self, kin, q: np.ndarray):
+        self.kinematics = kin
+        self._q = np.array(q, dtype=float)
+        self._queue: MotionQueue | None = None
+        self._t0 = 0.0
+        self._handles = 0
+
+    def q_at(self, t: float) -> np.ndarray:
+        if self._queue is None:
+            return self._q.copy()
+        tau = t - self._t0
+        return self._queue.q(min(tau, self._queue.end))
+
+    def busy(self, t: float) -> bool:
+        return self._queue is not None and t - self._t0 < self._queue.end
+
+    def plan_start(self, t: float) -> np.ndarray:
+        return self._queue.q_end if self.busy(t) else self.q_at(t)
+
+    def queue(self, traj: Trajectory, zone: Zone, t: float) -> int:
+        self._handles += 1
+        if not self.busy(t):
+            self._q = self.q_at(t)
+            self._queue, self._t0 = MotionQueue(traj.q_start), float(t)
+        self._queue.add(traj, zone, t - self._t0, self._handles)
+        return self._handles
+
+    def _segment(self, handle: int) -> Segment | None:
+        return self._queue.find(handle) if self._queue is not None else None
+
+    def start_time(self, handle: int) -> float | None:
+        seg = self._segment(handle)
+        return None if seg is None else self._t0 + seg.start
+
+    def end_time(self, handle: int) -> float | None:
+        seg = self._segment(handle)
+        return None if seg is None else self._t0 + seg.end
+
+    def ready_time(self, handle: int) -> float | None:
+        seg = self._segment(handle)
+        return None if seg is None else self._t0 + seg.ready
+
+    def ready(self, handle: int, t: float) -> bool:
+        at = self.ready_time(handle)
+        return at is None or t >= at - 1e-9
+
+    def done(self, handle: int, t: float) -> bool:
+        at = self.end_time(handle)
+        return at is None or t >= at - 1e-9
+
+    def corner_failure(self, handle: int) -> bool:
+        seg = self._segment(handle)
+        return seg is not None and seg.corner_failure
