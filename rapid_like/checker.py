@@ -54,6 +54,13 @@ _APPROXIMATE = {
     "triggequip": "the output is set when the TriggL/TriggJ motion ends, not at its Distance (EquipLag unused)",
     "triggint": "the interrupt occurs when the TriggL/TriggJ motion ends, not at its Distance on the path",
     "spystart": "no spy log is written",
+    "softact": "soft servo is not simulated: the arm keeps its stiffness (noted once in the event log)",
+    "softdeact": "soft servo is not simulated (noted once in the event log)",
+    "actunit": "the twin has no external mechanical units (noted once in the event log)",
+    "deactunit": "the twin has no external mechanical units (noted once in the event log)",
+    "waitwobj": "the twin has no conveyor: the work object is connected at once (noted once in the event log)",
+    "dropwobj": "the twin has no conveyor (noted once in the event log)",
+    "setleadthrough": "lead-through needs the real arm (noted once in the event log)",
     "waitrob": "motions end in position, so WaitRob never waits",
 }
 
@@ -119,6 +126,8 @@ class Checker:
         return key
 
     def undefined(self, name: str, span: Span, scope: dict[str, Sym], what: str = "") -> CheckError:
+        if rapid_names.refused(name):
+            return self.err(rapid_names.refused(name), span)
         kind = rapid_names.kind_of(name)
         if kind == "data":
             return self.err(f"{name} is RAPID predefined data that rapid_like does not define", span)
@@ -178,6 +187,8 @@ class Checker:
         arr = split_array_type(t)
         if arr:
             t = arr[0]
+        if t not in KNOWN_TYPES and rapid_names.refused(t):
+            raise self.err(rapid_names.refused(t), span)
         if t not in KNOWN_TYPES or (t in SIGNAL_TYPES and not allow_signals):
             close = difflib.get_close_matches(t, sorted(KNOWN_TYPES), n=1)
             hint = f" (did you mean {close[0]}?)" if close else ""
@@ -476,6 +487,8 @@ class Checker:
                 raise self.err(f"{s.name} is data, not an instruction (did you mean {s.name} := ...;?)", s.span)
             if key in _UNSUPPORTED:
                 raise self.err(f"{s.name} is not supported by rapid_like: {_UNSUPPORTED[key]}", s.span)
+            if rapid_names.refused(s.name):
+                raise self.err(rapid_names.refused(s.name), s.span)
             kind = rapid_names.kind_of(key)
             if kind is not None:
                 raise self.err(f"{s.name} is a RAPID {kind} that rapid_like does not implement", s.span)
@@ -763,6 +776,8 @@ class Checker:
             return rtype
         if key in B.INSTRUCTIONS:
             raise self.err(f"{e.name} is an instruction and returns no value", e.span)
+        if rapid_names.refused(e.name):
+            raise self.err(rapid_names.refused(e.name), e.span)
         kind = rapid_names.kind_of(key)
         if kind is not None:
             raise self.err(f"{e.name} is a RAPID {kind} that rapid_like does not implement", e.span)

@@ -482,9 +482,9 @@ class InstructionsMixin:
         self.active_tool, self.active_wobj = req.tool, req.wobj
         failed = getattr(self.host, "corner_failure", None)
         if failed is not None and self.last_motion is not None and self.corner_warning and failed(self.last_motion):
-            self.emit({"type": "warning", "line": s.span.line,
-                       "message": f"corner path failure: the motion before {instr} {req.target_name} ends at its "
-                                  f"zone point as at a fine point (this motion came too late for a corner path)"})
+            self.emit({"type": "errlog", "level": "warning", "header": "Corner path failure",
+                       "reason": f"line {s.span.line}: the motion before {instr} {req.target_name} ended at its zone "
+                                 f"point as at a fine point (this motion came too late for a corner path)"})
         self.last_motion = handle
         if arg("conc"):  # \Conc: the program goes on at once, the motion runs on
             self.concurrent = handle

@@ -102,3 +102,32 @@ def kind_of(name: str) -> str | None:
     if key in PREDEFINED_DATA:
         return "data"
     return None
+
+
+# RobotWare options the twin cannot honour: a program using them is refused where it names them, with the
+# option's name, never run wrongly. (Instructions, functions and data types alike.)
+_OPTIONS = {
+    "EGM (Externally Guided Motion)": ("an external computer steers the real controller's motion at 4 ms; the "
+                                       "twin's planner has no such input",
+                                       "egm"),
+    "arc welding (Arc, RobotWare Arc option)": ("welding equipment, seam tracking and weaving are not simulated",
+                                                "arcl arcc arclstart arclend arccstart arccend arcl1 arcl2 arcc1 arcc2 "
+                                                "arcrefresh arckill arcmoveextj seamdata welddata weavedata trackdata "
+                                                "arcdata advseamdata"),
+    "SmarTac (touch sensing)": ("touch sensing needs the real torch and work piece",
+                                "search_1d search_groove search_part search_ext smartac smartacdata"),
+    "MultiMove": ("rapid_like runs one motion task, so there is no other robot to move with",
+                  "syncmoveon syncmoveoff syncmoveundo syncmovesuspend syncmoveresume issyncmoveon moveextj "
+                  "searchextj"),
+}
+_OPTION_OF = {word: option for option, (_, words) in _OPTIONS.items() for word in words.split() if word != "egm"}
+
+
+def refused(name: str) -> str | None:
+    """Why `name` (an instruction, function or data type of a RobotWare option the twin cannot honour) is refused,
+    or None."""
+    key = name.lower()
+    option = "EGM (Externally Guided Motion)" if key.startswith("egm") else _OPTION_OF.get(key)
+    if option is None:
+        return None
+    return f"{name} belongs to {option}, which the twin cannot honour: {_OPTIONS[option][0]}"

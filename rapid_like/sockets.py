@@ -212,6 +212,20 @@ class SocketsMixin:
         st.sock, st.status = None, "SOCKET_CLOSED"
         yield from ()
 
+    def f_socketpeek(self, e, arg, bound):
+        """SocketPeek: how many bytes wait to be received on the socket (0 when none, or closed)."""
+        dev = arg("socket")
+        st = dev.state if isinstance(dev.state, SocketState) else None
+        self.changes += 1  # depends on the peer
+        if st is None or st.sock is None or st.status == "SOCKET_CLOSED":
+            raise self.fail("SocketPeek: the socket is closed (SocketCreate it first)", e.span, "ERR_SOCK_CLOSED")
+        try:
+            return float(len(st.sock.recv(RAWBYTES_MAX, socket.MSG_PEEK)))
+        except BlockingIOError:
+            return 0.0
+        except OSError:
+            return 0.0
+
     def f_socketgetstatus(self, e, arg, bound):
         dev = arg("socket")
         st = dev.state if isinstance(dev.state, SocketState) else None

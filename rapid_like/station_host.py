@@ -158,6 +158,11 @@ class TwinHost:
         t = robot.ready_time(handle) if what == "ready" else robot.end_time(handle)
         return None if t is None else to_ns(t)
 
+    def motor_torque(self, axis: int) -> float:
+        """GetMotorTorque: the physics arm's axis torque (N m); 0 without physics (an offline run)."""
+        torque = getattr(self.twin.robot, "motor_torque", None)
+        return torque(axis) if torque is not None else 0.0
+
     def current_robtarget(self, tool: Record | None, wobj: Record | None) -> Record:
         """CRobT: the TCP of `tool` in `wobj`; without them, those of the last motion (the active ones), or
         before any motion the station's tcp in the world (wobj0)."""

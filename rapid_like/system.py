@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import datetime
 import math
+import os
 
 from . import builtins as B
 from . import nodes as n
@@ -348,6 +349,101 @@ class SystemMixin:
     def i_triggj(self, s, arg, text, bound):
         yield from self._trigg_move(s, arg, text, bound, "MoveJ")
 
+    # ---- what only real hardware does: runs, and says so once in the event log ----------------------
+    def hardware_note(self, s, what: str) -> None:
+        """An instruction that only concerns the real robot's hardware: noted once per instruction in the
+        event log (an errlog event of level info), never silently."""
+        name = B.PROPER_NAMES.get(s.key, s.name)
+        if name in self.hardware_noted:
+            return
+        self.hardware_noted.add(name)
+        self.emit({"type": "errlog", "level": "info", "header": f"{name} in simulation",
+                   "reason": f"line {s.span.line}: {what}"})
+
+    def i_cornerpathwarning(self, s, arg, text, bound):
+        """CornerPathWarning FALSE: no "corner path failure" warning when a zone point becomes a stop point."""
+        self.corner_warning = bool(arg("status"))
+        yield from ()
+
+    def i_softact(self, s, arg, text, bound):
+        self._accept_all(bound, arg)
+        self.hardware_note(s, "soft servo changes how the real axes yield to external forces; the twin's arm "
+                              "is position-controlled and keeps its stiffness")
+        yield from ()
+
+    def i_softdeact(self, s, arg, text, bound):
+        self._accept_all(bound, arg)
+        self.hardware_note(s, "soft servo is not simulated (the arm keeps its stiffness)")
+        yield from ()
+
+    def i_actunit(self, s, arg, text, bound):
+        self._accept_all(bound, arg)
+        self.hardware_note(s, "the twin has no external mechanical units to activate or deactivate")
+        yield from ()
+
+    i_deactunit = i_actunit
+
+    def i_waitwobj(self, s, arg, text, bound):
+        """WaitWObj: conveyor tracking waits for an object on the conveyor; the twin has no conveyor, so the
+        work object is connected at once, where its frames say (TimeFlag FALSE)."""
+        self._accept_all(bound, arg)
+        if "timeflag" in bound:
+            arg("timeflag").set(False)
+        self.hardware_note(s, "the twin has no conveyor: the work object is taken as connected at once, at its "
+                              "frames as written")
+        yield from ()
+
+    def i_dropwobj(self, s, arg, text, bound):
+        self._accept_all(bound, arg)
+        self.hardware_note(s, "the twin has no conveyor: nothing to drop")
+        yield from ()
+
+    def i_setleadthrough(self, s, arg, text, bound):
+        self._accept_all(bound, arg)
+        self.hardware_note(s, "lead-through (moving the arm by hand) needs the real arm; the twin's arm stays "
+                              "under the program's control")
+        yield from ()
+
+    def _accept_all(self, bound, arg) -> None:
+        for k in bound:
+            arg(k)  # evaluated, for its errors
+
+    def f_getmotortorque(self, e, arg, bound):
+        """GetMotorTorque: the axis's torque (N m) as the physics arm's motor applies it now (0 offline)."""
+        axis = int(arg("axisno"))
+        if not 1 <= axis <= 6:
+            raise self.fail(f"GetMotorTorque: AxisNo must be 1 to 6, not {axis}", e.span, "ERR_ARGVALERR")
+        torque = getattr(self.host, "motor_torque", None)
+        self.changes += 1  # depends on the time
+        return float(torque(axis)) if torque is not None else 0.0
+
+    # ---- directories ------------------------------------------------------------------------------
+    def i_opendir(self, s, arg, text, bound):
+        """OpenDir: the directory's entries, read from disk (HOME:/x is x in the current directory), in name order."""
+        path = arg("path")
+        local = path.split(":", 1)[1].lstrip("/") if ":" in path[:12] else path
+        try:
+            names = sorted(os.listdir(local or "."))
+        except OSError:
+            raise self.fail(f"OpenDir {path}: no such directory", s.span, "ERR_FILEACC") from None
+        arg("dev").get().state = {"path": path, "names": names, "pos": 0}
+        yield from ()
+
+    def i_closedir(self, s, arg, text, bound):
+        arg("dev").state = None
+        yield from ()
+
+    def f_readdir(self, e, arg, bound):
+        st = arg("dev").state
+        if not isinstance(st, dict) or "names" not in st:
+            raise self.fail("ReadDir: the directory is not open (OpenDir it first)", e.span, "ERR_FILEACC")
+        if st["pos"] >= len(st["names"]):
+            return False
+        arg("filename").set(st["names"][st["pos"]])
+        st["pos"] += 1
+        self.changes += 1
+        return True
+
     # ---- files (iodev): written files go to the trace, read ones come from disk -----------------------
     def _path(self, arg) -> str:
         obj, name = arg("object"), arg("file")
@@ -380,6 +476,32 @@ class SystemMixin:
         if st["mode"] != mode:
             raise self.fail(f"the file {st['path']} is open for {st['mode']}ing", s.span, "ERR_FILEACC")
         return st
+
+    def i_writeanybin(self, s, arg, text, bound):
+        """WriteAnyBin: the value, in the file as its RAPID literal on a line of its own (the twin's "binary"
+        format: ReadAnyBin reads it back into data of the same type)."""
+        st = self._dev(arg, s, "write")
+        out = format_value(arg("data")) + "\n"
+        self.files[st["path"]] = self.files.get(st["path"], "") + out
+        self.emit({"type": "file", "file": st["path"], "text": out})
+        yield from ()
+
+    def i_readanybin(self, s, arg, text, bound):
+        st = self._dev(arg, s, "read")
+        ref = arg("data")
+        arg("time")
+        data, pos = st["data"], st["pos"]
+        if pos >= len(data):
+            raise self.fail(f"ReadAnyBin: end of file {st['path']}", s.span, "ERR_RANYBIN_EOF")
+        end = data.find("\n", pos)
+        end = len(data) if end < 0 else end
+        line, st["pos"] = data[pos:end], end + 1
+        try:
+            ref.set(literal_value(line, ref.type))
+        except Exception:  # noqa: BLE001 - text that is not a literal of the data's type
+            raise self.fail(f"ReadAnyBin: {line[:40]!r} in {st['path']} is not {ref.type} data", s.span,
+                            "ERR_RANYBIN_EOF") from None
+        yield from ()
 
     def i_write(self, s, arg, text, bound):
         st = self._dev(arg, s, "write")

@@ -240,3 +240,41 @@ ENDMODULE
     (station / "test.mod").write_text(ok)
     with redirect_stdout(io.StringIO()):
         assert rapid(["run", str(station / "test.mod"), "--station", str(station), "--entry", "main"]) == 0
+
+
+def test_open_dir_lists_a_directory_and_get_motor_torque_reads_the_physics_arm(tmp_path):
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    for name in ("b.txt", "a.txt"):
+        (folder / name).write_text("x")
+    p = tmp_path / "dir.mod"
+    p.write_text(f"""MODULE Dir
+  VAR dir d;
+  VAR string name;
+  PROC main()
+    OpenDir d, "{folder}";
+    WHILE ReadDir(d, name) DO
+      TPWrite name;
+    ENDWHILE
+    CloseDir d;
+  ENDPROC
+ENDMODULE
+""")
+    out = io.StringIO()
+    with redirect_stdout(out):
+        assert rapid(["run", str(p)]) == 0
+    assert out.getvalue().split() == ["a.txt", "b.txt"]
+    # axis 2 carries the arm's weight: the physics motor holds it with a torque, read by the program
+    program = f"""MODULE Torque
+  PERS num t2 := 0;
+  PROC main()
+    WaitTime 0.1;
+    t2 := GetMotorTorque(2);
+  ENDPROC
+ENDMODULE
+"""
+    with open_cell(station_with(tmp_path / "cell", program), entry="main") as cell:
+        while cell.controller.state != "completed":
+            cell.step()
+        t2 = cell.controller.interp.globals["t2"].value
+        assert abs(t2) > 100.0 and t2 == pytest.approx(cell.twin.robot.motor_torque(2), rel=0.05)

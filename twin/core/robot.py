@@ -80,6 +80,10 @@ class Robot:
         """Actual joint velocities (rad/s)."""
         return np.array([s[1] for s in self.client.getJointStates(self.body, self.joints)])
 
+    def motor_torque(self, axis: int) -> float:
+        """The torque (N m) the physics applied at axis `axis` (1-based) in the last (sub)step."""
+        return float(self.client.getJointState(self.body, self.joints[axis - 1])[3])
+
     @property
     def trajectory(self) -> Trajectory | None:
         return self._traj
