@@ -779,6 +779,8 @@ class Checker:
             raise self.fail(f"'{c.name}' is a function block type: declare an instance (t1 : {up};) and call it", c.span)
         if stdlib_fn.is_standard(up):
             return self.std_call(c, up, scope, expected)
+        if up in ("ADR", "REF", "SIZEOF", "ADRINST", "__NEW", "__DELETE"):
+            raise self.fail(f"{up}: pointers and references are not supported", c.span)
         raise self.fail(f"unknown function '{c.name}' (undeclared)", c.span)
 
     def fb_call(self, c: n.Call, fbt: ty.FbT, scope: _Scope, statement: bool) -> ty.DataType:

@@ -21,6 +21,8 @@ from .tokens import UNSUPPORTED, Kind, Lit, Token
 _VAR_SECTIONS = ("VAR", "VAR_INPUT", "VAR_OUTPUT", "VAR_IN_OUT", "VAR_GLOBAL", "VAR_EXTERNAL", "VAR_TEMP")
 _STMT_END = ("END_IF", "ELSIF", "ELSE", "END_CASE", "END_FOR", "END_WHILE", "UNTIL", "END_REPEAT",
              "END_PROGRAM", "END_FUNCTION", "END_FUNCTION_BLOCK")
+_IL_OPERATORS = {"LD", "LDN", "ST", "STN", "S", "R", "ANDN", "ORN", "XORN", "ADD", "SUB", "MUL", "DIV", "GT", "GE",
+                 "EQ", "NE", "LE", "LT", "JMPC", "JMPCN", "CAL", "CALC", "CALCN", "RET", "RETC", "RETCN"}
 _POU_END = {"PROGRAM": "END_PROGRAM", "FUNCTION": "END_FUNCTION", "FUNCTION_BLOCK": "END_FUNCTION_BLOCK"}
 
 
@@ -411,6 +413,10 @@ class Parser:
             raise self.error(f"expected a statement, found {t.describe()}")
         if t.upper in ("STEP", "TRANSITION", "ACTION") and self.peek().kind is Kind.IDENT:
             raise self.error(f"{t.upper}: SFC (sequential function charts) is not supported")
+        nxt = self.peek()
+        if t.upper in _IL_OPERATORS and nxt.span.line == t.span.line and (
+                nxt.kind in (Kind.IDENT, Kind.LITERAL, Kind.DIRECT) or nxt.is_op("%")):
+            raise self.error(f"{t.upper} {nxt.text}: Instruction List (IL) is not supported; write Structured Text")
         target = self.postfix(self.primary())
         if self.tok.is_op(":="):
             self.advance()

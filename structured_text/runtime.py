@@ -242,6 +242,24 @@ class Plc:
         return g or None
 
     # ---- images ----------------------------------------------------------------------------------
+    def located(self) -> list[tuple[str, str, str]]:
+        """(address, variable, type) of every located variable, e.g. ("%IX100.0", "main.start", "BOOL"):
+        what a binding to a fieldbus (a Modbus map) maps, checked once before the first scan."""
+        out = []
+
+        def text(loc):
+            area, size, idx = loc
+            return f"%{area}{size}{'.'.join(str(i) for i in idx)}"
+        for s in self.program.globals.values():
+            if s.location is not None:
+                out.append((text(s.location), s.name, s.type.name))
+        single = len(self.program.instances) == 1
+        for inst in self.program.instances:
+            for s in inst.pou.symbols.values():
+                if s.location is not None and s.section != "VAR_EXTERNAL":
+                    out.append((text(s.location), s.name if single else f"{inst.name}.{s.name}", s.type.name))
+        return out
+
     def read_located(self, address: str):
         area, size, idx = parse_address(address)
         image = {"I": self.inputs, "Q": self.outputs, "M": self.memory}[area]

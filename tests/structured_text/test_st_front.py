@@ -91,6 +91,7 @@ def test_operator_precedence_is_the_standards():
     ("PROGRAM p\nINITIAL_STEP s1: END_STEP\nEND_PROGRAM\n", (2, 1), "SFC"),
     ("FUNCTION_BLOCK f EXTENDS g\nEND_FUNCTION_BLOCK\n", (1, 18), "not supported"),
     ("PROGRAM p\nVAR p : POINTER TO INT; END_VAR\nEND_PROGRAM\n", (2, 9), "pointers"),
+    ("PROGRAM p\nVAR a, b : BOOL; END_VAR\n  LD a\n  ST b\nEND_PROGRAM\n", (3, 3), "Instruction List (IL) is not supported"),
 ])
 def test_parse_errors_and_unsupported_features_name_the_place(src, pos, message):
     with pytest.raises(ParseError) as e:

@@ -197,6 +197,8 @@ END_PROGRAM
     plc.write_located("%IX100.0", False)
     plc.scan(0.01)
     assert plc.read_located("%QX100.0") is False and plc.get("main.count") == 2
+    assert plc.located() == [("%IX100.0", "start", "BOOL"), ("%IW100", "level", "INT"), ("%QX100.0", "motor", "BOOL"),
+                             ("%QW100", "speed", "INT"), ("%MD4", "count", "DINT")]
 
 
 def test_a_runtime_error_keeps_the_plc_in_stop(tmp_path):
