@@ -293,15 +293,20 @@ def station_logic(args) -> str:
 
 
 def cmd_run(args) -> int:
-    from .client import ClientIO
-    from .scan import ScanCycle
-    from twin.modbus.register_map import SPEED_PCT
-
     if args.target is None:
         args.target = station_logic(args)
     logic = load_logic(args.target)
     rmap = load_map(args)
     check_logic_signals(args.target, logic, rmap)
+    return _run_logic(args, logic, rmap)
+
+
+def _run_logic(args, logic, rmap: RegisterMap) -> int:
+    """Run `logic` on a scan cycle against the server (`plc run`), printing its outputs' changes."""
+    from .client import ClientIO
+    from .scan import ScanCycle
+    from twin.modbus.register_map import SPEED_PCT
+
     with connect(args, rmap) as client:
         io = ClientIO(client, lockstep=args.lockstep)
         speed = args.speed
@@ -347,6 +352,52 @@ def structured_text_command(argv: list[str]) -> list[str] | None:
                 return [a] + rest
             return None
     return None
+
+
+def run_st_against_twin(argv: list[str]) -> int:
+    """`plc run FILE.st... --port P [--station DIR | --map FILE.json] [--cycle MS] [--for S | --scans N]
+    [--lockstep | --realtime]`: a Structured Text PLC against a running twin (`twin serve --layout plc`), its
+    located variables bound through the map's device ranges as on a Modbus master PLC (`plc_client.st_io`)."""
+    p = Parser(prog="plc run", description="Run a Structured Text PLC against a running twin server (--layout plc).")
+    p.add_argument("files", nargs="+", metavar="FILE.st")
+    _globals(p, suppress=False)
+    p.add_argument("--cycle", type=positive_float, default=10.0, metavar="MS", help="scan cycle in ms (default 10)")
+    bound = p.add_mutually_exclusive_group()
+    bound.add_argument("--for", dest="seconds", type=positive_float, default=None, metavar="S", help="PLC seconds to run")
+    bound.add_argument("--scans", type=positive_int, default=None, help="scans to run")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--lockstep", dest="lockstep", action="store_true", default=None,
+                      help="each scan advances the server one cycle (default: when the server runs in lockstep)")
+    mode.add_argument("--realtime", dest="lockstep", action="store_false", help="pace the scans against the wall clock")
+    p.add_argument("--speed", type=positive_float, default=None, metavar="X", help="real time: X times the wall clock")
+    p.add_argument("--quiet", action="store_true", help="do not print the outputs' changes")
+    args = p.parse_args([a for a in argv if a != "run"])
+    logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
+    from structured_text.errors import PlcFault, StError
+
+    from .st_io import StLogic
+
+    try:
+        rmap = RegisterMap.from_station(args.station, "plc") if args.station else load_map(args)
+        logic = StLogic(args.files, rmap)
+    except (ConnectionFailedError, ModbusExceptionError) as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_CONNECTION
+    except StError as exc:
+        print(exc.headline(), file=sys.stderr)
+        return 65
+    except (TwinError, OSError) as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_USER
+    args.target, args.cycle = " ".join(args.files), args.cycle / 1000.0
+    try:
+        return _run_logic(args, logic, rmap)
+    except PlcFault as exc:
+        print(exc.headline(), file=sys.stderr)
+        return 70
+    except (ConnectionFailedError, ModbusExceptionError) as exc:
+        print(f"plc: error: {exc}", file=sys.stderr)
+        return EXIT_CONNECTION
 
 
 def check_with_map(argv: list[str]) -> int:
@@ -430,6 +481,8 @@ def main(argv: list[str] | None = None) -> int:
     st = structured_text_command(argv)
     if st is not None and st[0] == "check" and any(a.split("=")[0] in ("--station", "--map", "--port") for a in argv):
         return check_with_map(argv)
+    if st is not None and st[0] == "run" and "--offline" not in argv and not set(argv) & {"-h", "--help"}:
+        return run_st_against_twin(argv)
     if st is not None and not (len(st) == 2 and st[1] in ("-h", "--help") and st[0] == "run"):
         from structured_text.cli import check_main, run_main
         return (check_main if st[0] == "check" else run_main)(st[1:])

@@ -102,3 +102,32 @@ class LocatedBinding:
             slot[1 if v.word == "LO" else 0] = int(w)
         by_name = {e.name: e for e in self.output_entries}
         return {name: by_name[name].decode(w) for name, w in words.items()}
+
+
+class StLogic:
+    """A Structured Text PLC as a scan-cycle logic (`plc_client.scan`): each scan writes its input image from
+    the signals (through `LocatedBinding`), runs the PLC's tasks at the scan's time (`inputs.time`: the cell's
+    time in lockstep, so runs repeat bit for bit), and returns its located outputs as signals. So it runs
+    wherever a Python logic does: `plc run FILE.st --port P` over Modbus, in process on a cell. Its state is
+    the PLC itself (`structured_text.runtime.Plc`, compiled once); a runtime error stops it (`PlcFault`)."""
+
+    def __init__(self, files: list, rmap: RegisterMap):
+        from structured_text.runtime import compile_files
+
+        self.files = [str(f) for f in files]
+        self.compiled = compile_files(self.files)
+        self.binding = LocatedBinding(rmap)
+        self.inputs = tuple(e.name for e in self.binding.input_entries)
+        self.outputs = tuple(e.name for e in self.binding.output_entries)
+
+    def initial_state(self):
+        from structured_text.runtime import Plc
+
+        return Plc(self.compiled)
+
+    def __call__(self, inputs: Mapping, plc) -> dict:
+        values = {n: inputs[n] for n in self.inputs if n in inputs}
+        for address, word in self.binding.input_image(values).items():
+            plc.write_located(address, word)
+        plc.scan(float(getattr(inputs, "time", 0.0)))
+        return self.binding.output_values({v.address: plc.read_located(v.address) for v in self.binding.outputs})

@@ -61,3 +61,19 @@ def test_the_shipped_gripper_plc_and_its_declarations_check_against_the_station(
     json_map.write_text(subprocess.run([sys.executable, "-m", "twin", "map", str(CELL), "--format", "json"], cwd=ROOT,
                                        capture_output=True, text=True, check=True).stdout)
     assert plc("check", str(CELL / "gripper.st"), str(CELL / "io.st"), "--map", str(json_map)).returncode != 0
+
+
+def test_the_st_gripper_plc_grips_the_ring_over_modbus_in_lockstep():
+    """`plc run gripper.st io.st --port P` against `twin serve --layout plc --lockstep`: the robot's first pick
+    from outside is gripped by force, as with the Python PLC (the robot says so in the server's log)."""
+    sys.path.insert(0, str(ROOT / "tests" / "modbus"))
+    from modbus_helpers import ServerProcess
+
+    with ServerProcess(CELL, "--lockstep", "--layout", "plc") as server:
+        assert plc("--port", str(server.port), "write", "fullAutoRun=1").returncode == 0  # the operator's switch
+        out = plc("run", str(CELL / "gripper.st"), str(CELL / "io.st"), "--port", str(server.port), "--for", "3")
+        assert out.returncode == 0, out.stderr
+        server.wait_for(r"robot: Gripped the ring, attempt 1", timeout=10)
+    changes = [line for line in out.stdout.splitlines() if line.startswith("t=")]
+    assert any("diGripOk=1" in line for line in changes), changes
+    assert not any("diGripFault=1" in line for line in changes), changes
