@@ -11,8 +11,8 @@ The algebra is the standard's own:
     CTD:  LD -> CV := PV; else a rising edge of CD and CV > PVmin -> CV := CV - 1; Q := CV <= 0
     CTUD: R -> 0; else LD -> PV; else one edge alone counts (up below PVmax, down above PVmin);
           QU := CV >= PV; QD := CV <= 0
-(PVmax/PVmin are the limits of the counter's integer type: CTU counts past PV. matiec stops CTU
-and CTUD at PV and CTD at 0; the standard does not.)
+The standard leaves PVmax and PVmin to the implementation (3rd ed. table 45, 2nd ed. table 35);
+here, as in matiec/OpenPLC's library, PVmax is PV and PVmin is 0: CTU stops counting at PV, CTD at 0.
 Timers follow the standard's timing diagrams; time is the scan's time, so a timer started at the
 scan of t0 is due at the first scan at or after t0 + PT:
     TON: IN rising starts timing; ET := elapsed (at most PT); Q once ET = PT; IN FALSE resets Q, ET.
@@ -79,7 +79,6 @@ class F_TRIG(StdFB):
 
 
 def _counters(suffix: str, t: ty.Elementary) -> dict:
-    lo, hi = t.lo, t.hi
 
     class CTU(StdFB):
         __slots__ = ("v_cu", "v_r", "v_pv", "v_q", "v_cv", "_cu_m")
@@ -95,7 +94,7 @@ def _counters(suffix: str, t: ty.Elementary) -> dict:
             self._cu_m = bool(self.v_cu)
             if self.v_r:
                 self.v_cv = 0
-            elif edge and self.v_cv < hi:
+            elif edge and self.v_cv < self.v_pv:
                 self.v_cv += 1
             self.v_q = self.v_cv >= self.v_pv
 
@@ -113,7 +112,7 @@ def _counters(suffix: str, t: ty.Elementary) -> dict:
             self._cd_m = bool(self.v_cd)
             if self.v_ld:
                 self.v_cv = self.v_pv
-            elif edge and self.v_cv > lo:
+            elif edge and self.v_cv > 0:
                 self.v_cv -= 1
             self.v_q = self.v_cv <= 0
 
@@ -136,9 +135,9 @@ def _counters(suffix: str, t: ty.Elementary) -> dict:
             elif self.v_ld:
                 self.v_cv = self.v_pv
             elif not (up and down):
-                if up and self.v_cv < hi:
+                if up and self.v_cv < self.v_pv:
                     self.v_cv += 1
-                elif down and self.v_cv > lo:
+                elif down and self.v_cv > 0:
                     self.v_cv -= 1
             self.v_qu = self.v_cv >= self.v_pv
             self.v_qd = self.v_cv <= 0

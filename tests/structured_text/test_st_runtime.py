@@ -88,12 +88,16 @@ END_PROGRAM
         plc.scan_ns(k * 10 * MS)
         pulses.append(plc.get("rt.Q"))
     assert pulses == [True, False] * 4
-    assert plc.get("up.CV") == 4 and plc.get("up.Q")  # counts past PV (PVmax is the limit, not PV)
-    assert plc.get("ud.CV") == 4 and plc.get("ud.QU") and not plc.get("ud.QD")
+    # four edges, PV = 2: the counters stop at PV (PVmax is the implementation's: PV, as matiec's)
+    assert plc.get("up.CV") == 2 and plc.get("up.Q")
+    assert plc.get("ud.CV") == 2 and plc.get("ud.QU") and not plc.get("ud.QD")
+    plc.set("cu", False)
+    plc.scan_ns(90 * MS)
     plc.set("cd", True)  # CU and CD both rise: CTUD does not count
     plc.set("cu", True)
     plc.scan_ns(100 * MS)
-    assert plc.get("ud.CV") == 4
+    assert plc.get("ud.CV") == 2
+    assert plc.get("dn.CV") == 0 and plc.get("dn.Q")  # CTD stops at 0
     plc.set("ld", True)
     plc.scan_ns(110 * MS)
     assert plc.get("dn.CV") == 2 and plc.get("ud.CV") == 2
@@ -104,17 +108,15 @@ END_PROGRAM
     assert plc.get("up.CV") == 0 and plc.get("ud.CV") == 0  # R dominates LD in CTUD
 
 
-def test_ctu_stops_at_the_top_of_its_type(tmp_path):
+def test_ctud_counts_down_to_zero_and_up_to_pv(tmp_path):
     plc = plc_of(tmp_path, """
 PROGRAM main
-VAR c : CTU; k : INT; END_VAR
-c(CU := FALSE, R := FALSE, PV := 5);
-FOR k := 1 TO 3 DO c(CU := TRUE, PV := 5); c(CU := FALSE, PV := 5); END_FOR;
+VAR c : CTUD; k : INT; END_VAR
+FOR k := 1 TO 3 DO c(CU := FALSE, CD := TRUE, PV := 2); c(CU := FALSE, CD := FALSE, PV := 2); END_FOR;
 END_PROGRAM
 """)
-    plc.set("c.CV", 32766)
     plc.scan_ns(0)
-    assert plc.get("c.CV") == 32767  # PVmax of INT: no wrap to -32768
+    assert plc.get("c.CV") == 0 and plc.get("c.QD")  # three downward edges from 0: stays at 0
 
 
 TASKS = """
