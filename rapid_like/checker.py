@@ -34,11 +34,11 @@ _APPROXIMATE = {
     "pathresol": "the path resolution does not change the simulated motion",
     "cirpathmode": "the tool orientation along a circle is not changed by CirPathMode",
     "worldacclim": "acceleration limits are not simulated",
-    "stopmove": "motions are not queued: StopMove only holds the next motion until StartMove",
-    "startmove": "motions are not queued: StartMove releases motions held by StopMove",
-    "clearpath": "motions are not queued: there is no path to clear",
-    "storepath": "motions are not queued: StorePath keeps nothing",
-    "restopath": "motions are not queued: RestoPath restores nothing",
+    "stopmove": "StopMove only holds the next motion until StartMove (the motions under way go on)",
+    "startmove": "StartMove releases motions held by StopMove",
+    "clearpath": "the motions handed to the planner are not cleared",
+    "storepath": "StorePath keeps nothing",
+    "restopath": "RestoPath restores nothing",
     "pdispset": "program displacement is not applied to the motions",
     "pdispoff": "program displacement is not applied to the motions",
     "eoffsoff": "external axes are not simulated",
@@ -61,7 +61,7 @@ _APPROXIMATE = {
     "waitwobj": "the twin has no conveyor: the work object is connected at once (noted once in the event log)",
     "dropwobj": "the twin has no conveyor (noted once in the event log)",
     "setleadthrough": "lead-through needs the real arm (noted once in the event log)",
-    "waitrob": "motions end in position, so WaitRob never waits",
+    "waitrob": "WaitRob waits for a \\Conc motion, and with \\InPos or \\ZeroSpeed for the robot at rest",
 }
 
 # RAPID instructions that are deliberately left out of the subset, with what to do instead.

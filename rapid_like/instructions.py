@@ -343,6 +343,8 @@ class InstructionsMixin:
         """WaitRob: wait until a \\Conc motion still running has ended."""
         for k in bound:
             arg(k)
+        if arg("inpos") or arg("zerospeed"):  # the robot at rest at the end of its motions
+            yield from self.wait_in_position(s, "WaitRob")
         handle = getattr(self, "concurrent", None)
         while handle is not None and not self.host.motion_done(handle):
             yield from self.pause(Wait("motion", None, "WaitRob", s.span))
@@ -372,7 +374,18 @@ class InstructionsMixin:
         yield from self._move(s, arg, text, bound, "MoveL")
         self.write(arg("signal"), 0.0 if arg("value") == 0 else 1.0)
 
+    def wait_in_position(self, s, what: str):
+        """\\InPos: wait until the robot has come to rest at the end of the motions handed to it (the last
+        one, a zone point, becomes a stop point)."""
+        handle = self.last_motion
+        while handle is not None and not self.host.motion_done(handle):
+            wake = getattr(self.host, "motion_wake", lambda h, w: None)
+            yield from self.pause(Wait("motion", wake(handle, "end"), f"{what} \\InPos", s.span))
+        self.last_motion = None  # a stop point by the program's will: no corner path failure to warn of
+
     def i_waittime(self, s, arg, text, bound):
+        if arg("inpos"):
+            yield from self.wait_in_position(s, "WaitTime")
         t = arg("time")
         if t < 0:
             raise self.fail(f"WaitTime needs a time >= 0, not {fmt_num(t)}", bound["time"].value.span,
@@ -411,6 +424,8 @@ class InstructionsMixin:
                 yield from self.pause(Wait("signal", deadline, name, s.span))
 
     def i_waituntil(self, s, arg, text, bound):
+        if arg("inpos"):
+            yield from self.wait_in_position(s, "WaitUntil")
         cond = bound["cond"].value
         poll = to_ns(arg("pollrate", 0.1))
         if poll <= 0:

@@ -278,3 +278,49 @@ ENDMODULE
             cell.step()
         t2 = cell.controller.interp.globals["t2"].value
         assert abs(t2) > 100.0 and t2 == pytest.approx(cell.twin.robot.motor_torque(2), rel=0.05)
+
+
+def offline_trace(tmp_path, program: str) -> list[dict]:
+    station = station_with(tmp_path, program)
+    out = io.StringIO()
+    with redirect_stdout(out):
+        assert rapid(["run", str(station / "test.mod"), "--station", str(station), "--entry", "main", "--trace"]) == 0
+    return [json.loads(line) for line in out.getvalue().splitlines()]
+
+
+def test_a_zone_point_whose_next_motion_comes_too_late_stops_and_is_warned_of_unless_told_not_to(tmp_path):
+    body = """MoveJ p0, v1000, fine, tG;
+    MoveL Offs(p0,400,0,0), v500, z50, tG;
+    WaitTime 1;
+    MoveL Offs(p0,400,600,0), v500, z50, tG;
+    WaitTime \\InPos, 0;
+    MoveL p0, v500, fine, tG;"""
+    program = square("fine").replace("""MoveJ p0, v1000, fine, tG;
+    
+    MoveL Offs(p0,400,0,0), v500, fine, tG;
+    MoveL Offs(p0,400,600,0), v500, fine, tG;
+    MoveL Offs(p0,0,600,0), v500, fine, tG;
+    MoveL p0, v500, fine, tG;""", body)
+    assert body in program
+    warned = [e for e in offline_trace(tmp_path / "a", program) if e["type"] == "errlog"]
+    # the WaitTime 1 kept the next motion from the planner: the robot stopped at the zone point (ABB's 50024);
+    # the WaitTime \InPos asked for the stop: no warning for it
+    assert len(warned) == 1 and warned[0]["header"] == "Corner path failure" and "line 8:" in warned[0]["reason"]
+    quiet = program.replace("MoveJ p0, v1000, fine, tG;", "MoveJ p0, v1000, fine, tG;\n    CornerPathWarning FALSE;")
+    assert not [e for e in offline_trace(tmp_path / "b", quiet) if e["type"] == "errlog"]
+
+
+def test_movel_with_t_takes_that_time_and_a_heavier_payload_accelerates_less(tmp_path):
+    def duration(tmp, before: str, move: str) -> float:
+        program = line_program(before).replace("MoveL Offs(p0,0,600,0), v500, fine, tG;", move)
+        events = offline_trace(tmp, program)
+        start = next(e["t"] for e in events if e["type"] == "move" and e["instr"] == "MoveL")
+        return events[-1]["t"] - start
+
+    # \T: the motion takes 3 s (the manual: the total time of the movement), to the controller's 12 ms tick
+    assert duration(tmp_path / "t", "", "MoveL Offs(p0,0,600,0), v500 \\T:=3, fine, tG;") == pytest.approx(3.0,
+                                                                                                          abs=0.013)
+    light = duration(tmp_path / "light", "", "MoveL Offs(p0,0,600,0), v2000, fine, tG;")
+    heavy = duration(tmp_path / "heavy", "GripLoad [200,[0,0,100],[1,0,0,0],0,0,0];",
+                     "MoveL Offs(p0,0,600,0), v2000, fine, tG;")
+    assert heavy > light + 0.05  # the rated payload on top of the gripper: about half the acceleration

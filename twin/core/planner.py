@@ -265,6 +265,7 @@ class KinematicRobot:
         self._queue: MotionQueue | None = None
         self._t0 = 0.0
         self._handles = 0
+        self._corner_failures: set[int] = set()
 
     def q_at(self, t: float) -> np.ndarray:
         if self._queue is None:
@@ -281,9 +282,15 @@ class KinematicRobot:
     def queue(self, traj: Trajectory, zone: Zone, t: float) -> int:
         self._handles += 1
         if not self.busy(t):
+            last = self._queue.last if self._queue is not None else None
+            if last is not None and not last.zone.fine:  # it ran out of motions at a zone point: a stop point
+                self._corner_failures.add(last.handle)
             self._q = self.q_at(t)
             self._queue, self._t0 = MotionQueue(traj.q_start), float(t)
+        prev = self._queue.last
         self._queue.add(traj, zone, t - self._t0, self._handles)
+        if prev is not None and prev.corner_failure:
+            self._corner_failures.add(prev.handle)
         return self._handles
 
     def _segment(self, handle: int) -> Segment | None:
@@ -310,5 +317,4 @@ class KinematicRobot:
         return at is None or t >= at - 1e-9
 
     def corner_failure(self, handle: int) -> bool:
-        seg = self._segment(handle)
-        return seg is not None and seg.corner_failure
+        return handle in self._corner_failures

@@ -53,6 +53,7 @@ class Robot:
         self._traj: Trajectory | None = None  # the last motion of the queue
         self._queue: MotionQueue | None = None
         self._handles = 0
+        self._corner_failures: set[int] = set()  # zone points that became stop points (their next motion late)
         #: why the last motion ended without arriving (e.g. blocked by a collision), else None
         self.fault: str | None = None
         self._t0: float | None = 0.0
@@ -140,6 +141,9 @@ class Robot:
         """Append `trajectory` (planned from `plan_start()`) to the motions under way at simulated time t: it
         starts when the last one ends, or blends out of its zone (planner.py). Returns the motion's handle."""
         if self._queue is None or self._t0 is None or not self.busy(t):
+            last = self._queue.last if self._queue is not None else None
+            if last is not None and not last.zone.fine:  # it ran out of motions at a zone point: a stop point
+                self._corner_failures.add(last.handle)
             self._queue = MotionQueue(trajectory.q_start)
             self._t0 = float(t)
             return self._append(trajectory, zone, 0.0)
@@ -147,7 +151,10 @@ class Robot:
 
     def _append(self, trajectory: Trajectory, zone: Zone, now: float) -> int:
         self._handles += 1
+        prev = self._queue.last
         self._queue.add(trajectory, zone, now, self._handles)
+        if prev is not None and prev.corner_failure:
+            self._corner_failures.add(prev.handle)
         self._traj, self._settled, self.fault = trajectory, False, None
         self._end_tcp = self.kinematics.fk(trajectory.q_end) if self.kinematics is not None else None
         return self._handles
@@ -175,8 +182,7 @@ class Robot:
 
     def corner_failure(self, handle: int) -> bool:
         """Did zone point `handle` become a stop point because its next motion came too late?"""
-        seg = self._segment(handle)
-        return seg is not None and seg.corner_failure
+        return handle in self._corner_failures
 
     def ready_time(self, handle: int) -> float | None:
         """The simulated time the program may go on past motion `handle` (`ready`), None if unknown."""
