@@ -88,7 +88,7 @@ def seconds(text: str) -> float:
 def run_main(argv: list[str]) -> int:
     ap = _Parser(prog="plc run", description="Run Structured Text offline: simulated time, no twin.")
     ap.add_argument("files", nargs="+", metavar="FILE.st")
-    ap.add_argument("--offline", action="store_true", help="run without a twin (required for now)")
+    ap.add_argument("--offline", action="store_true", help="run without a twin (without it, `plc run` binds to one)")
     ap.add_argument("--for", dest="duration", required=False, metavar="SECONDS", help="simulated seconds to run")
     ap.add_argument("--cycle", metavar="MS", default=None,
                     help="scan cycle in milliseconds (default 10; with a CONFIGURATION the GCD of its task intervals)")
@@ -113,8 +113,7 @@ def run_main(argv: list[str]) -> int:
 def _run(args) -> int:
     from .runtime import DEFAULT_LOOP_BUDGET, Plc, compile_files
     if not args.offline:
-        raise UsageError("running Structured Text against a twin is not there yet: add --offline "
-                         "(simulated time, no twin)")
+        raise UsageError("this runs Structured Text offline: add --offline (simulated time, no twin)")
     if args.duration is None:
         raise UsageError("--for SECONDS is required")
     duration = seconds(args.duration)

@@ -79,9 +79,3 @@ def test_endless_loop_is_stopped(tmp_path):
     r = plc("run", src, "--offline", "--for", "0.1", "--loop-budget", "1000")
     assert r.returncode == 70
     assert r.stderr.startswith(f"{src}:3:1: error: the scan does not end")
-
-
-def test_run_without_offline_is_a_clear_usage_error(tmp_path):
-    src = write(tmp_path, "p.st", "PROGRAM main\nVAR i : INT; END_VAR\ni := 1;\nEND_PROGRAM\n")
-    r = plc("run", src, "--for", "0.1")
-    assert r.returncode == 2 and "--offline" in r.stderr
