@@ -14,7 +14,8 @@ The algebra is the standard's own:
 The standard leaves PVmax and PVmin to the implementation (3rd ed. table 45, 2nd ed. table 35);
 here, as in matiec/OpenPLC's library, PVmax is PV and PVmin is 0: CTU stops counting at PV, CTD at 0.
 Timers follow the standard's timing diagrams; time is the scan's time, so a timer started at the
-scan of t0 is due at the first scan at or after t0 + PT:
+scan of t0 is due at the first scan at or after t0 + PT (the scan of the edge only starts the timing,
+as in matiec's library: with PT = 0, Q changes one scan after the edge):
     TON: IN rising starts timing; ET := elapsed (at most PT); Q once ET = PT; IN FALSE resets Q, ET.
     TOF: Q := TRUE while IN; IN falling starts timing; Q FALSE once ET = PT; IN TRUE resets ET.
     TP:  IN rising (while not pulsing) starts a pulse of PT: Q TRUE, ET counts to PT; after it
@@ -167,17 +168,16 @@ class TON(_Timer):
 
     def _body(self):
         now = self._clk.now
-        if not self.v_in:
+        if self._state == 0 and not self._prev and self.v_in:  # the rising edge starts the timing
+            self._state, self.v_q, self._start = 1, False, now
+        elif not self.v_in:
             self.v_q, self.v_et, self._state = False, 0, 0
-        else:
-            if self._state == 0 and not self._prev:
-                self._state, self._start = 1, now
-            if self._state == 1:
-                et = now - self._start
-                if et >= self.v_pt:
-                    self._state, self.v_q, self.v_et = 2, True, self.v_pt
-                else:
-                    self.v_et = et
+        elif self._state == 1:
+            et = now - self._start
+            if et >= self.v_pt:
+                self._state, self.v_q, self.v_et = 2, True, self.v_pt
+            else:
+                self.v_et = et
         self._prev = bool(self.v_in)
 
 
@@ -186,17 +186,16 @@ class TOF(_Timer):
 
     def _body(self):
         now = self._clk.now
-        if self.v_in:
+        if self._state == 0 and self._prev and not self.v_in:  # the falling edge starts the timing
+            self._state, self._start = 1, now
+        elif self.v_in:
             self.v_et, self._state = 0, 0
-        else:
-            if self._state == 0 and self._prev:
-                self._state, self._start = 1, now
-            if self._state == 1:
-                et = now - self._start
-                if et >= self.v_pt:
-                    self._state, self.v_et = 2, self.v_pt
-                else:
-                    self.v_et = et
+        elif self._state == 1:
+            et = now - self._start
+            if et >= self.v_pt:
+                self._state, self.v_et = 2, self.v_pt
+            else:
+                self.v_et = et
         self.v_q = bool(self.v_in) or self._state == 1
         self._prev = bool(self.v_in)
 
@@ -206,9 +205,9 @@ class TP(_Timer):
 
     def _body(self):
         now = self._clk.now
-        if self._state == 0 and self.v_in and not self._prev:
-            self._state, self._start, self.v_q, self.v_et = 1, now, True, 0
-        if self._state == 1:
+        if self._state == 0 and self.v_in and not self._prev:  # the rising edge starts a pulse
+            self._state, self._start, self.v_q = 1, now, True
+        elif self._state == 1:
             et = now - self._start
             if et >= self.v_pt:
                 self._state, self.v_q, self.v_et = 2, False, self.v_pt
