@@ -853,6 +853,13 @@ def format_report(report: Report) -> str:
     n_warn = sum(c.level == WARN for c in report.checks)
     n_pass = sum(c.level == PASS for c in report.checks)
     lines.append(f"verdict: {'FAIL' if n_fail else 'PASS'} ({n_pass} pass, {n_warn} warn, {n_fail} fail)")
+    failed: dict[str, dict[str, list[str]]] = {}  # where -> who -> measures
+    for c in report.checks:
+        if c.level == FAIL:
+            failed.setdefault(c.where, {}).setdefault(c.who, []).append(c.measure)
+    for where, whos in failed.items():
+        lines.append(f"  failed in {where}: " + "; ".join(f"{who} {', '.join(dict.fromkeys(m))}"
+                                                            for who, m in whos.items()))
     return "\n".join(lines)
 
 
