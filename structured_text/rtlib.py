@@ -168,6 +168,31 @@ def _endless(site):
     raise Fault("the scan does not end: the loop ran past the scan's budget of iterations (an endless loop?)", site)
 
 
+def _bcd_from(v, site):
+    """A BCD-coded bit string to its number (16#1234 -> 1234); a nibble above 9 is an error."""
+    out, mul = 0, 1
+    while v:
+        d = v & 15
+        if d > 9:
+            raise Fault(f"not a BCD value: a digit {d} (16#{d:X})", site)
+        out += d * mul
+        v >>= 4
+        mul *= 10
+    return out
+
+
+def _bcd_to(v, site):
+    """A number to its BCD code (1234 -> 16#1234); a negative number is an error."""
+    if v < 0:
+        raise Fault(f"{v} has no BCD code (negative)", site)
+    out, shift = 0, 0
+    while v:
+        out |= (v % 10) << shift
+        v //= 10
+        shift += 4
+    return out
+
+
 def _left(s, n):
     return s[:max(0, n)]
 

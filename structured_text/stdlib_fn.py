@@ -20,12 +20,19 @@ FORMALS = {
     "FIND": ("IN1", "IN2"), "EXPT": ("IN1", "IN2"),
 }
 _LOGIC = {"AND": "&", "OR": "|", "XOR": "^"}
+# the 2nd edition's named time functions (still in the 3rd): name -> (operator, argument kinds)
+_TIME_FUNCS = {"ADD_TIME": ("+", "time", "time"), "ADD_TOD_TIME": ("+", "tod", "time"), "ADD_DT_TIME": ("+", "dt", "time"),
+               "SUB_TIME": ("-", "time", "time"), "SUB_DATE_DATE": ("-", "date", "date"),
+               "SUB_TOD_TIME": ("-", "tod", "time"), "SUB_TOD_TOD": ("-", "tod", "tod"),
+               "SUB_DT_TIME": ("-", "dt", "time"), "SUB_DT_DT": ("-", "dt", "dt"),
+               "MULTIME": ("*", "time", "num"), "DIVTIME": ("/", "time", "num"), "MUL_TIME": ("*", "time", "num"),
+               "DIV_TIME": ("/", "time", "num"), "CONCAT_DATE_TOD": ("+", "date", "tod")}
 EXTENSIBLE = {"ADD", "MUL", "MAX", "MIN", "CONCAT", "MUX", "GT", "GE", "EQ", "LE", "LT", "AND", "OR", "XOR"}
 _MATH1 = {"SQRT": "_sqrt", "LN": "_ln", "LOG": "_log", "EXP": "_exp", "SIN": "_m.sin", "COS": "_m.cos",
           "TAN": "_m.tan", "ASIN": "_asin", "ACOS": "_acos", "ATAN": "_m.atan"}
 NAMES = {"ABS", "EXPT", "ADD", "SUB", "MUL", "DIV", "MOD", "MOVE", "SHL", "SHR", "ROL", "ROR", "SEL", "MAX", "MIN",
          "LIMIT", "MUX", "GT", "GE", "EQ", "LE", "LT", "NE", "LEN", "LEFT", "RIGHT", "MID", "CONCAT", "INSERT",
-         "DELETE", "REPLACE", "FIND", "TRUNC", "TIME", "ATAN2", "AND", "OR", "XOR"} | set(_MATH1)
+         "DELETE", "REPLACE", "FIND", "TRUNC", "TIME", "ATAN2", "AND", "OR", "XOR"} | set(_TIME_FUNCS) | set(_MATH1)
 _DT_KINDS = ("time", "date", "tod", "dt")
 
 
@@ -36,6 +43,8 @@ class SignatureError(Exception):
 def conversion(name: str) -> tuple[ty.DataType | None, ty.DataType] | None:
     """`INT_TO_REAL` -> (INT, REAL); `TO_REAL` -> (None, REAL); TRUNC_INT / REAL_TRUNC_DINT too."""
     up = name.upper()
+    if "BCD" in up:
+        return None
     for sep in ("_TO_", "_TRUNC_"):
         if sep in up:
             a, _, b = up.partition(sep)
@@ -52,9 +61,23 @@ def conversion(name: str) -> tuple[ty.DataType | None, ty.DataType] | None:
     return None
 
 
+def bcd(name: str) -> tuple[str, ty.DataType, ty.DataType | None] | None:
+    """`WORD_BCD_TO_INT` / `BCD_TO_INT` -> ("from", WORD|None, INT); `INT_TO_BCD_WORD` / `INT_TO_BCD` -> ("to", ...)."""
+    up = name.upper()
+    for a, sep, b in (up.partition("_BCD_TO_"), up.partition("_TO_BCD_")):
+        if sep and a in ty.ELEMENTARY and b in ty.ELEMENTARY:
+            return ("from", ty.ELEMENTARY[a], ty.ELEMENTARY[b]) if sep == "_BCD_TO_" else \
+                ("to", ty.ELEMENTARY[a], ty.ELEMENTARY[b])
+    if up.startswith("BCD_TO_") and up[7:] in ty.ELEMENTARY:
+        return "from", None, ty.ELEMENTARY[up[7:]]
+    if up.endswith("_TO_BCD") and up[:-7] in ty.ELEMENTARY:
+        return "to", ty.ELEMENTARY[up[:-7]], None
+    return None
+
+
 def is_standard(name: str) -> bool:
     up = name.upper()
-    return up in NAMES or conversion(up) is not None
+    return up in NAMES or conversion(up) is not None or bcd(up) is not None
 
 
 def _num(t: ty.DataType, what: str) -> None:
@@ -76,6 +99,15 @@ def _common(ts: list[ty.DataType], name: str) -> ty.DataType:
 
 def signature(name: str, ts: list[ty.DataType]) -> ty.DataType:
     up = name.upper()
+    b = bcd(up)
+    if b:
+        if len(ts) != 1 or ts[0].kind not in ("int", "bits"):
+            raise SignatureError(f"{name} converts one integer or bit string")
+        way, src, dst = b
+        if dst is None:  # INT_TO_BCD: the bit string of the same width
+            bits = max(8, ts[0].bits if ts[0] is not ty.LIT_INT else 16)
+            dst = ty.ELEMENTARY[{8: "BYTE", 16: "WORD", 32: "DWORD", 64: "LWORD"}[bits]]
+        return dst
     conv = conversion(up)
     if conv:
         src, dst = conv
@@ -140,6 +172,15 @@ def signature(name: str, ts: list[ty.DataType]) -> ty.DataType:
     if up == "MOVE":
         arity(1)
         return ts[0]
+    if up in _TIME_FUNCS:
+        arity(2)
+        op, ka, kb = _TIME_FUNCS[up]
+        for t, k in zip(ts, (ka, kb)):
+            if (t.kind != k) if k != "num" else not ty.is_numeric(t):
+                raise SignatureError(f"{up} takes ({ka.upper()}, {kb.upper()}), not ({ts[0]}, {ts[1]})")
+        if up == "CONCAT_DATE_TOD":
+            return ty.ELEMENTARY["DATE_AND_TIME"]
+        return ty.arith_type(op, ts[0], ts[1])
     if up in _LOGIC:
         if n < 2:
             raise SignatureError(f"{up} takes at least two arguments")
@@ -205,6 +246,9 @@ def signature(name: str, ts: list[ty.DataType]) -> ty.DataType:
 def generate(name: str, codes: list[str], ts: list[ty.DataType], result: ty.DataType, site: int) -> str:
     """Python for a call of the standard function `name` on argument code `codes` (already typed)."""
     up = name.upper()
+    b = bcd(up)
+    if b:
+        return stdlib_wrap(result, f"_bcd_{b[0]}({codes[0]}, {site})")
     conv = conversion(up)
     if conv:
         return convert(codes[0], ts[0], result, truncate="TRUNC" in up)
@@ -231,6 +275,13 @@ def generate(name: str, codes: list[str], ts: list[ty.DataType], result: ty.Data
         return divide(up, c[0], c[1], result, site)
     if up == "MOVE":
         return c[0]
+    if up in _TIME_FUNCS:
+        op = _TIME_FUNCS[up][0]
+        if op == "/":
+            return f"_tdiv({c[0]}, {c[1]}, {site})"
+        if op == "*" and ts[1].kind == "real":
+            return f"_round({c[0]} * {c[1]})"
+        return f"({c[0]} {op} {c[1]})"
     if up in _LOGIC:
         if result.kind == "bool":
             if up == "XOR":
@@ -349,3 +400,7 @@ def divide(op: str, a: str, b: str, result: ty.DataType, site: int) -> str:
     if result.kind == "time":
         return f"_tdiv({a}, {b}, {site})"
     return f"_idiv({a}, {b}, {site})"
+
+
+def stdlib_wrap(t: ty.DataType, code: str) -> str:
+    return wrap_code(t, code) if t.kind in ("int", "bits") else code

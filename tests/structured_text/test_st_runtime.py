@@ -243,3 +243,19 @@ def test_the_bench_runs_at_a_tiny_size(capsys):
     assert main(["--scans", "30", "--statements", "60", "--repeat", "1"]) == 0
     out = capsys.readouterr().out
     assert "ST / Python" in out and "60-statement program" in out
+
+
+def test_named_time_functions_and_bcd_conversions(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR t : TIME; w : WORD; i : INT; d : DT; dd : DATE := D#2024-01-01; tod1 : TOD := TOD#01:00:00; END_VAR
+t := DIVTIME(MULTIME(ADD_TIME(T#1s, T#500ms), 2), 4);
+w := INT_TO_BCD(1234);
+i := WORD_BCD_TO_INT(16#0987);
+d := CONCAT_DATE_TOD(dd, tod1);
+END_PROGRAM
+""")
+    plc.scan_ns(0)
+    assert plc.get("t") == 750 * MS  # (1.5 s x 2) / 4
+    assert plc.get("w") == 0x1234 and plc.get("i") == 987  # one decimal digit per nibble
+    assert plc.resolve("d").json() == "DT#2024-01-01-01:00:00"
