@@ -52,11 +52,18 @@ def read_source(path: str | Path) -> str:
 
 
 def compile_files(paths: list[str | Path], sources: dict[str, str] | None = None) -> Compiled:
-    """Parse, check and compile the files of one PLC program (StError on the first stage that fails)."""
-    files = []
+    """Parse, check and compile the files of one PLC program (StError on the first stage that fails; the
+    syntax errors of every file together)."""
+    from .errors import StaticErrors
+    files, errors = [], []
     for p in paths:
         text = sources[str(p)] if sources and str(p) in sources else read_source(p)
-        files.append(parse(text, str(p)))
+        try:
+            files.append(parse(text, str(p)))
+        except StError as exc:
+            errors.append(exc)
+    if errors:
+        raise errors[0] if len(errors) == 1 else StaticErrors(errors)
     program = check(files)
     return compile_program(program)
 
@@ -276,8 +283,10 @@ class Plc:
         image[(size, idx)] = value
 
     # ---- variables by name -----------------------------------------------------------------------
-    def resolve(self, name: str) -> "VarRef":
-        """`cnt` (the single program's), `main.cnt`, `fb.Q`, `main.arr[2]`, a global."""
+    def resolve(self, name: str) -> "VarRef | LocatedRef":
+        """`cnt` (the single program's), `main.cnt`, `fb.Q`, `main.arr[2]`, a global, or an address `%IX0.0`."""
+        if name.strip().startswith("%"):
+            return LocatedRef(self, name.strip())
         return VarRef(self, name)
 
     def get(self, name: str):
@@ -434,6 +443,30 @@ class VarRef:
         for o, a, image, key in self.plc._located_in:
             if o is target and a == attr:
                 image[key] = value
+
+
+class LocatedRef:
+    """A direct address of the process images (`%IX100.0`, `%QW3`) by its text; `set` on an input address
+    writes the input image, which the next scan reads."""
+
+    _TYPES = {"X": "BOOL", "B": "BYTE", "W": "WORD", "D": "DWORD", "L": "LWORD"}
+
+    def __init__(self, plc: Plc, address: str):
+        try:
+            _, size, _ = parse_address(address)
+        except ValueError as exc:
+            raise KeyError(str(exc)) from None
+        self.plc, self.name = plc, address
+        self.type = ty.ELEMENTARY[self._TYPES[size]]
+
+    def get(self):
+        return self.plc.read_located(self.name)
+
+    def set(self, value) -> None:
+        self.plc.write_located(self.name, coerce(self.type, value))
+
+    def json(self):
+        return json_value(self.type, self.get())
 
 
 def _describe(exc: BaseException) -> str:

@@ -79,3 +79,26 @@ def test_endless_loop_is_stopped(tmp_path):
     r = plc("run", src, "--offline", "--for", "0.1", "--loop-budget", "1000")
     assert r.returncode == 70
     assert r.stderr.startswith(f"{src}:3:1: error: the scan does not end")
+
+
+def test_set_and_watch_direct_addresses(tmp_path):
+    src = write(tmp_path, "loc.st", """
+PROGRAM main
+VAR b AT %IX0.0 : BOOL; q AT %QW2 : WORD; END_VAR
+q := SEL(b, 16#0001, 16#00FF);
+IF %IX0.1 THEN q := 7; END_IF;
+END_PROGRAM
+""")
+    r = plc("run", src, "--offline", "--for", "0.04", "--set", "%IX0.0=TRUE@0.01", "--set", "%IX0.1=1@0.03",
+            "--watch", "%QW2,b", "--trace")
+    assert r.returncode == 0, r.stderr
+    assert [(x["scan"], x["name"], x["value"]) for x in trace(r.stdout)] == [
+        (0, "%QW2", 1), (0, "b", False), (1, "%QW2", 255), (1, "b", True), (3, "%QW2", 7)]
+
+
+def test_check_reports_the_syntax_errors_of_every_file(tmp_path):
+    a = write(tmp_path, "a.st", "PROGRAM a\nVAR x : INT; END_VAR\nx := ;\nEND_PROGRAM\n")
+    b = write(tmp_path, "b.st", "FUNCTION_BLOCK f\nVAR y : INT END_VAR\nEND_FUNCTION_BLOCK\n")
+    r = plc("check", a, b)
+    assert r.returncode == 65
+    assert [line.split(": error:")[0] for line in r.stderr.splitlines()] == [f"{a}:3:6", f"{b}:2:13"]
