@@ -111,19 +111,50 @@ class StLogic:
     wherever a Python logic does: `plc run FILE.st --port P` over Modbus, in process on a cell. Its state is
     the PLC itself (`structured_text.runtime.Plc`, compiled once); a runtime error stops it (`PlcFault`)."""
 
-    def __init__(self, files: list, rmap: RegisterMap):
-        from structured_text.runtime import compile_files
+    def __init__(self, files: list, rmap: RegisterMap, settings: Mapping[str, Any] | None = None):
+        """`settings`: values for the program's variables before the first scan (a campaign's `plc.NAME`:
+        its VAR CONSTANT parameters or VAR_INPUTs, by name, case-insensitive)."""
+        from structured_text.runtime import Plc, compile_files
 
         self.files = [str(f) for f in files]
         self.compiled = compile_files(self.files)
         self.binding = LocatedBinding(rmap)
         self.inputs = tuple(e.name for e in self.binding.input_entries)
         self.outputs = tuple(e.name for e in self.binding.output_entries)
+        self.settings = dict(settings or {})
+        self.instance = self.compiled.program.instances[0].name if self.compiled.program.instances else ""
+        probe = Plc(self.compiled)
+        for name, value in self.settings.items():  # a wrong name or value is an error now, not at the first scan
+            probe.set(f"{self.instance}.{name}", value)
+        self._watched = all(self._has(probe, n) for n in ("phase", "fault_code"))
+
+    def _has(self, plc, name: str) -> bool:
+        try:
+            plc.get(f"{self.instance}.{name}")
+        except Exception:  # noqa: BLE001 - the runtime names what it cannot resolve
+            return False
+        return True
 
     def initial_state(self):
         from structured_text.runtime import Plc
 
-        return Plc(self.compiled)
+        plc = Plc(self.compiled)
+        for name, value in self.settings.items():
+            plc.set(f"{self.instance}.{name}", value)
+        return plc
+
+    def sequence_state(self, plc):
+        """The grip sequence's phase and fault, when the program keeps them as `phase` and `fault_code` in the
+        codes of `plc_client.grip_sequence` (Phase, Fault), as the shipped gripper PLC in ST does: a campaign
+        counts grips and names the PLC's faults from them as from a Python GripSequence. Else None."""
+        if not self._watched:
+            return None
+        from types import SimpleNamespace
+
+        from .grip_sequence import Fault, Phase
+
+        return SimpleNamespace(phase=Phase(int(plc.get(f"{self.instance}.phase"))),
+                               fault=Fault(int(plc.get(f"{self.instance}.fault_code"))))
 
     def __call__(self, inputs: Mapping, plc) -> dict:
         values = {n: inputs[n] for n in self.inputs if n in inputs}

@@ -50,8 +50,34 @@ def add_command(subparsers) -> None:
     p.add_argument("--recordings", type=int, default=10, metavar="N",
                    help="record and plot at most N failing scenarios (re-run, in failures/; default 10, 0: none)")
     p.add_argument("--list", action="store_true", help="list the scenarios and their expectations, run nothing")
+    p.add_argument("--plc", metavar="REF", default=None,
+                   help="run another PLC than the file's driver.plc: \"module:logic\" or Structured Text files beside "
+                        "the campaign file (\"gripper.st io.st\")")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress line")
     p.set_defaults(func=cmd_campaign)
+
+
+def with_plc(campaign, ref: str):
+    """The campaign with another PLC driver (`--plc`), checked as `driver.plc` is."""
+    import dataclasses
+
+    from .spec import SpecError, st_files
+
+    if campaign.driver.kind != "plc":
+        raise SpecError(campaign.file, "driver", f"--plc {ref}: the campaign's driver is {campaign.driver.kind}, not plc")
+    if st_files(ref):
+        missing = [n for n in st_files(ref) if not (campaign.driver.base / n).is_file()]
+        if missing:
+            raise SpecError(campaign.file, "driver.plc", f"--plc: {missing[0]}: no such file in {campaign.driver.base}")
+        ref = " ".join(st_files(ref))
+    else:
+        from twin.plugins import LoadError, load_object
+
+        try:
+            load_object(ref, campaign.driver.base)
+        except LoadError as exc:
+            raise SpecError(campaign.file, "driver.plc", f"--plc: {exc}") from None
+    return dataclasses.replace(campaign, driver=dataclasses.replace(campaign.driver, ref=ref))
 
 
 def cmd_campaign(args) -> int:
@@ -62,6 +88,8 @@ def cmd_campaign(args) -> int:
 
     try:
         campaign = load_campaign(args.spec)
+        if args.plc:
+            campaign = with_plc(campaign, args.plc)
     except SpecError as exc:
         print(f"twin campaign: error: {exc}", file=sys.stderr)
         return 2

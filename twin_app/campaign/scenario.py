@@ -229,6 +229,8 @@ class GripWatch:
         self.sequences = []
         if isinstance(logic, GripSequence):
             self.sequences.append((logic, lambda: state))
+        elif getattr(logic, "sequence_state", None) is not None and logic.sequence_state(state) is not None:
+            self.sequences.append((logic, lambda: logic.sequence_state(state)))  # an ST PLC with phase, fault_code
         elif isinstance(logic, Combined):
             for i, part in enumerate(logic.logics):
                 if isinstance(part, GripSequence):
@@ -267,9 +269,22 @@ class GripWatch:
 
 
 # -- running ------------------------------------------------------------------------------------------------
-def make_logic(campaign: Campaign, params: dict):
-    obj = load_object(campaign.driver.ref, campaign.driver.base)
+def make_logic(campaign: Campaign, params: dict, station=None):
     kwargs = {k.split(".", 1)[1]: v for k, v in params.items() if k.startswith("plc.")}
+    from .spec import st_files
+
+    if st_files(campaign.driver.ref):  # a Structured Text PLC on the station's PLC layout; plc.NAME sets its NAME
+        from plc_client.st_io import StLogic
+        from twin.modbus.register_map import build_register_map
+        from twin.core.signal_table import station_signals
+        from structured_text.errors import StError
+
+        try:
+            return StLogic([campaign.driver.base / f for f in st_files(campaign.driver.ref)],
+                           build_register_map(station_signals(station), station.name, "plc"), settings=kwargs)
+        except (StError, TwinError) as exc:
+            raise ScenarioError(f"driver.plc {campaign.driver.ref!r}: {exc}") from None
+    obj = load_object(campaign.driver.ref, campaign.driver.base)
     if getattr(obj, "inputs", None) is not None and not isinstance(obj, type):
         if kwargs:
             raise ScenarioError(f"driver.plc {campaign.driver.ref!r} is a logic, not a factory: it takes no "
@@ -389,7 +404,7 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
         part_start = twin.object_pose(part)[0] if part else None
         logic, local = None, {}
         if driver.kind == "plc":
-            logic = make_logic(campaign, params)
+            logic = make_logic(campaign, params, station)
             have = {s.name for s in cell.signals}
             held = getattr(logic, "handshake_signals", None)
             local = {k: v for k, v in (held() if held else {}).items() if k not in have}

@@ -296,6 +296,13 @@ def _expr(file, key, text) -> Expression:
         raise SpecError(file, key, str(exc)) from None
 
 
+def st_files(ref) -> list[str]:
+    """A PLC driver given as Structured Text files ("gripper.st io.st", or a list of them), else []."""
+    names = ref.split() if isinstance(ref, str) else ref if isinstance(ref, list) else []
+    ok = names and all(isinstance(n, str) and n.lower().endswith(".st") for n in names)
+    return list(names) if ok else []
+
+
 def _driver(file, d: dict) -> Driver:
     kinds = [k for k in ("plc", "rapid", "check") if k in d]
     if len(kinds) != 1:
@@ -309,14 +316,20 @@ def _driver(file, d: dict) -> Driver:
             ref = ""
         elif not isinstance(ref, str) or not ref:
             raise SpecError(file, "driver.rapid", f"must be true (the station's program) or a program file, not {ref!r}")
+    elif kind == "plc" and st_files(ref):
+        for name in st_files(ref):  # a Structured Text PLC: its files, beside the campaign file
+            if not (file.parent / name).is_file():
+                raise SpecError(file, "driver.plc", f"{name}: no such file (beside {file.name})")
+        ref = " ".join(st_files(ref))
     elif not isinstance(ref, str) or ":" not in ref:
-        raise SpecError(file, f"driver.{kind}", f"must be \"module:name\" or \"file.py:name\", not {ref!r}")
+        raise SpecError(file, f"driver.{kind}", f"must be \"module:name\", \"file.py:name\" or Structured Text "
+                                                f"files (\"gripper.st io.st\"), not {ref!r}")
     scan = _number(file, "driver.scan", d.get("scan", 0.010), positive=True)
     entry = d.get("entry")
     if entry is not None and not isinstance(entry, str):
         raise SpecError(file, "driver.entry", f"must be a routine name, not {entry!r}")
     driver = Driver(kind, ref, entry, scan, file.parent.resolve())
-    if kind != "rapid":
+    if kind != "rapid" and not st_files(ref):
         from twin.plugins import LoadError, load_object
 
         try:

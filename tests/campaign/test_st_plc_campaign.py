@@ -1,0 +1,41 @@
+"""The shipped campaign with the gripper PLC in Structured Text (`twin campaign ... --plc "gripper.st io.st"`):
+the same verdict per scenario as with the Python PLC, from physics and signals. Three of its fault scenarios
+here (each PLC runs them in process, in lockstep); all fifteen agree in a full run (docs/plc-on-real-hardware.md)."""
+import csv
+import subprocess
+import sys
+
+import pytest
+
+from tests.conftest import STATIONS
+from twin_app.campaign import LocalBackend, load_campaign, run_campaign
+from twin_app.campaign.cli import with_plc
+
+SHIPPED = STATIONS / "ring_rig_plc" / "campaign.toml"
+VERDICT = ("outcome", "fault", "grips", "misses", "grip", "plc_faults", "part_present")
+pytestmark = pytest.mark.skipif(not (STATIONS.parent / "structured_text" / "runtime.py").exists(),
+                                reason="the ST runtime has not landed")
+
+
+def verdicts(campaign, out, indices) -> dict[str, tuple]:
+    result = run_campaign(campaign, LocalBackend(1), out, indices=indices, quiet=True)
+    assert result.counts["error"] == 0, [r.get("message") for r in result.records]
+    return {r["index"]: tuple(r[c] for c in VERDICT) for r in csv.DictReader((out / "results.csv").open())}
+
+
+def test_the_st_and_the_python_gripper_plc_give_the_same_verdicts(tmp_path):
+    python = load_campaign(SHIPPED)
+    st = with_plc(python, "gripper.st io.st")
+    names = {sc.index: sc.name for sc in python.scenarios}
+    picked = [i for i, n in names.items() if n.startswith(("finger jammed at 345", "finger jammed open", "drive of finger 2 lost during"))]
+    assert len(picked) == 3
+    a = verdicts(python, tmp_path / "python", picked)
+    b = verdicts(st, tmp_path / "st", picked)
+    assert a == b
+    assert {v[5] for v in a.values()} == {"jammed", "drive_lost"}  # the PLCs named the finger faults
+
+
+def test_a_campaign_refuses_a_plc_it_cannot_find():
+    out = subprocess.run([sys.executable, "-m", "twin", "campaign", str(SHIPPED), "--plc", "nowhere.st", "--list"],
+                         capture_output=True, text=True)
+    assert out.returncode == 2 and "nowhere.st: no such file" in out.stderr
