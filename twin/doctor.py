@@ -12,7 +12,7 @@ judged against issue 18's thresholds (docs/check.md says why each one):
     force      the finger's force = its drive's effort (shared over a mimic linkage) within 10 %
     penetration  closest distance of the nominal shapes >= -0.5 mm
     push       a centred part pushed < 0.5 mm by the closing grip
-    creep      a resting part < 0.1 mm in the hold time (5 s); a held part < 0.2 mm relative to the fingers
+    creep      a resting part < 0.1 mm in the hold time (5 s); a held part < 0.2 mm relative to the gripper
     capacity   mu x sum of the normal forces >= 3 x the weight (below 1 x it cannot hold); a lift keeps it within 1 mm
 
 Nothing here knows a station: every number comes from the station file, its URDFs and the physics.
@@ -35,7 +35,7 @@ PUSH = 0.5e-3  # m: a closing grip moves a centred part less than this
 CENTRED = 0.5e-3  # m: fingers whose gaps to the part agree within this close on a centred part
 REST_CREEP = 0.1e-3  # m in the hold time: a part resting on its support
 REST_SETTLE = 0.5  # s a part placed on its support is given to settle (sink into its contacts) before creep counts
-HELD_CREEP = 0.2e-3  # m in the hold time: a held part relative to the fingers
+HELD_CREEP = 0.2e-3  # m in the hold time: a held part relative to the gripper (the palm its fingers ride on)
 CAPACITY = 3.0  # friction capacity / weight a grip needs to promise a lift
 LIFT_SLIP = 1e-3  # m: such a grip lifts the part within this
 LIFT = 0.1  # m: how far a robot lifts the part
@@ -344,6 +344,7 @@ class Doctor:
         self.want_picture = picture
         self.pictures: list = []
         self._gripped_at = None  # the part in the base link's frame when doGripped rose
+        self.carrier = twin.world.link_index[twin.mechanism.base_link]  # the palm: see `relative`
         self.lift_axis: tuple[str, float] | None = None  # without a robot: an axis that lifts every finger alike
         self.log = log or (lambda text: None)
         st = twin.station
@@ -374,12 +375,14 @@ class Doctor:
         return Pose(*self.twin.object_pose(name))
 
     def relative(self, name: str):
-        """The part's position relative to the fingers (their links' centroid), in the world's axes: what a part
-        that stays put in the grip keeps, while the gripper stands or lifts straight."""
-        points = [self.c.getLinkState(self.body, links[0], computeForwardKinematics=True)[4]
-                  for links in self.g.finger_links.values()]
-        centre = [sum(p[i] for p in points) / len(points) for i in range(3)]
-        return self.part_pose(name).position - centre
+        """The part's position in the frame of the link that carries the fingers' drives (the palm: the gripper's
+        base, or what a gantry's lift moves): what a part that stays put in the grip keeps."""
+        j = self.carrier
+        if j < 0:
+            p, o = self.c.getBasePositionAndOrientation(self.body)
+        else:
+            p, o = self.c.getLinkState(self.body, j, computeForwardKinematics=True)[4:6]
+        return (Pose(p, o).inverse() * self.part_pose(name)).position
 
     def tcp(self) -> Pose:
         if self.twin.robot is not None:
@@ -467,6 +470,9 @@ class Doctor:
                 sign = {1.0: "increasing", -1.0: "decreasing"}
                 self.check(FAIL, "station", d, "closing", f"its fingers close with {sign[mine]} {d}, the twin takes "
                            f"{sign[twins]} {d} for closing (its status 2 and 1 are swapped)")
+        first = next((d for d in drive_of.values() if d is not None), None)
+        if first is not None:  # the link the (first) closing drive's joint sits on
+            self.carrier = self.c.getJointInfo(self.body, self.g.joint[first])[16]
         if self.twin.robot is None:
             self.lift_axis = self.reach.lift_axis(set(drive_of.values()), self.twin.station.gravity)
         for body in st.targets:
@@ -747,7 +753,7 @@ class Doctor:
             self.check(INFO, where, "grip", "push", f"part moved {_fmt_len(result.push)} while the fingers closed "
                        "(not centred between the fingers: no limit)")
         self.check(PASS if result.held_creep < HELD_CREEP else FAIL, where, "grip", "creep",
-                   f"{_fmt_len(result.held_creep)} relative to the fingers in {self.hold:g} s held at rest "
+                   f"{_fmt_len(result.held_creep)} relative to the gripper in {self.hold:g} s held at rest "
                    f"(< {_fmt_len(HELD_CREEP, digits=1)})")
         ratio = result.capacity / result.weight if result.weight else float("inf")
         fingers = ", ".join(f"{f} {r.normal_force:.4g} N" for f, r in res.items())
@@ -799,7 +805,7 @@ class Doctor:
         result.lift_slip = float(sum((self.relative(name) - rel0) ** 2) ** 0.5)
         result.lift_signal_slip = bool(tw.read("slip"))
         ratio = result.capacity / result.weight if result.weight else float("inf")
-        text = (f"part moved {_fmt_len(result.lift_slip)} relative to the fingers in a {height * 1000:.0f} mm lift and "
+        text = (f"part moved {_fmt_len(result.lift_slip)} relative to the gripper in a {height * 1000:.0f} mm lift and "
                 f"1 s hanging (slip {'raised' if result.lift_signal_slip else 'low'})")
         if ratio >= CAPACITY or self.g.spec.grip == "attach":
             self.check(PASS if result.lift_slip <= LIFT_SLIP else FAIL, where, "grip", "lift",
