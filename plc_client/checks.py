@@ -1,9 +1,11 @@
 """The client's checks before the wire: names and values against the register map, in engineering units.
 
-The map itself is the one `twin.modbus.register_map.RegisterMap`; what the client adds is how it refuses:
-an unknown name gets suggestions (`UnknownSignalError`), a value is checked against the entry's range, or
-for an entry without one against its type's (whole numbers for integer types of scale 1, finite float32),
-and an output of the twin is not writable. Nothing is clamped or rounded into range.
+The map itself is the one `twin.modbus.register_map.RegisterMap`; a value is checked by the one write
+validation, `SignalSpec.check`, on the entry as a signal in engineering units (its range, or for an entry
+without one its type's: whole numbers for integer types of scale 1, finite float32). What the client adds
+is how it refuses: an unknown name gets suggestions (`UnknownSignalError`), a refusal names the signal and
+the range in the map's units (`ValueOutOfRangeError`, `ValueTypeError`: the twin's SignalRangeError and
+SignalTypeError), an output of the twin is not writable. Nothing is clamped or rounded into range.
 
     signal = lookup(rmap, "axis1.actual")       # the entry, or UnknownSignalError ("did you mean ...?")
     value = check_value(rmap, "axis1", 320.0)   # 320.0, or a SignalValueError naming signal, value and range
@@ -14,9 +16,11 @@ import math
 from collections.abc import Iterable
 from typing import Any
 
+from twin.core.errors import SignalRangeError, SignalTypeError
+from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
 from twin.modbus.register_map import TYPE_LIMITS, Entry, RegisterMap
 
-from .errors import NotWritableError, SignalValueError, UnknownSignalError, ValueOutOfRangeError
+from .errors import NotWritableError, UnknownSignalError, ValueOutOfRangeError, ValueTypeError
 
 FLOAT32_MAX = 3.4028234663852886e38  # the largest finite IEEE 754 single
 
@@ -44,38 +48,38 @@ def check_value(rmap: RegisterMap, name: str, value: Any) -> Any:
 
 
 def check_entry_value(s: Entry, value: Any) -> Any:
-    """`check_value` for an entry already looked up (its access not checked)."""
+    """`check_value` for an entry already looked up (its access not checked): the one write validation,
+    `SignalSpec.check`, on the entry as a signal in engineering units (a bool for a bit, the index for an
+    enumeration's text, else the number as checked)."""
+    try:
+        checked = entry_spec(s).check(value)
+    except SignalRangeError as exc:
+        raise ValueOutOfRangeError(s.name, value, exc.min if math.isfinite(exc.min) else None,
+                                   exc.max if math.isfinite(exc.max) else None, s.unit) from None
+    except SignalTypeError as exc:
+        raise ValueTypeError(s.name, f"needs {exc.expected}, not {value!r}") from None
+    if s.choices:
+        return s.choices.index(checked)
+    return checked
+
+
+def entry_spec(s: Entry) -> SignalSpec:
+    """A map entry as the signal it carries, in the map's engineering units: its range, else its type's
+    (whole numbers for integer types of scale 1, a finite float32)."""
     if s.type == "bool":
-        if isinstance(value, bool) or value in (0, 1):
-            return bool(value)
-        raise SignalValueError(s.name, f"needs true or false (1 or 0), not {value!r}")
-    if s.choices and isinstance(value, str):
-        if value not in s.choices:
-            raise SignalValueError(s.name, f"{value!r} is not one of {', '.join(repr(c) for c in s.choices)}")
-        return s.choices.index(value)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-        raise SignalValueError(s.name, f"needs a number, not {value!r}")
-    slack = 1e-9 * max(1.0, abs(s.min or 0.0), abs(s.max or 0.0))  # the map's limits carry 9 decimals: an exact end passes
-    if (s.min is not None and value < s.min - slack) or (s.max is not None and value > s.max + slack):
-        raise ValueOutOfRangeError(s.name, value, s.min, s.max, s.unit)
-    if s.type == "float32":
-        if math.isinf(value) or abs(value) > FLOAT32_MAX:
-            raise ValueOutOfRangeError(s.name, value, -FLOAT32_MAX if s.min is None else s.min,
-                                       FLOAT32_MAX if s.max is None else s.max, s.unit)
-        return value
+        return SignalSpec(s.name, INPUT, BOOL)
+    if s.choices:
+        return SignalSpec(s.name, INPUT, ENUM, choices=tuple(s.choices))
+    lo, hi = s.min, s.max
     limits = TYPE_LIMITS.get(s.type)
-    if limits is not None:  # the type's own range, for entries without min or max
-        if math.isinf(value):
-            raise SignalValueError(s.name, f"needs a finite number, not {value!r}")
-        counts = value / s.scale
-        if s.scale == 1.0 and counts != int(counts):
-            raise SignalValueError(s.name, f"needs a whole number ({s.type}), not {value!r}")
-        lo_c, hi_c = limits
-        if not lo_c <= round(counts) <= hi_c:
-            lo = s.min if s.min is not None else _eng(lo_c * s.scale)
-            hi = s.max if s.max is not None else _eng(hi_c * s.scale)
-            raise ValueOutOfRangeError(s.name, value, lo, hi, s.unit)
-    return value
+    if s.type == "float32":
+        lo = -FLOAT32_MAX if lo is None else lo
+        hi = FLOAT32_MAX if hi is None else hi
+    elif limits is not None:
+        lo = _eng(limits[0] * s.scale) if lo is None else lo
+        hi = _eng(limits[1] * s.scale) if hi is None else hi
+    kind = INT if limits is not None and s.scale == 1.0 else FLOAT
+    return SignalSpec(s.name, INPUT, kind, s.unit, lo, hi)
 
 
 def range_text(s: Entry) -> str:

@@ -37,7 +37,7 @@ from twin.modbus.protocol import DEFAULT_PORT, TLS_PORT
 
 from .checks import check_names, check_value, lookup, range_text
 from .client import RegisterMap, Signal, TwinClient
-from .errors import ConnectionFailedError, ModbusExceptionError, OutputRefusedError, PlcClientError, SignalValueError
+from .errors import ConnectionFailedError, ModbusExceptionError, OutputRefusedError, PlcClientError, ValueTypeError
 
 EXIT_USER, EXIT_CONNECTION = 2, 1
 TRUE, FALSE = ("1", "true", "on", "yes", "high"), ("0", "false", "off", "no", "low")
@@ -443,13 +443,13 @@ def parse_value(s: Signal, text: str):
             return True
         if low in FALSE:
             return False
-        raise SignalValueError(s.name, f"needs 1 or 0 (true/false, on/off), not {text!r}")
+        raise ValueTypeError(s.name, f"needs 1 or 0 (true/false, on/off), not {text!r}")
     if s.choices and text in s.choices:
         return text
     try:
         value = float(text)
     except ValueError:
-        raise SignalValueError(s.name, f"needs a number{' in ' + s.unit if s.unit else ''}, not {text!r}") from None
+        raise ValueTypeError(s.name, f"needs a number{' in ' + s.unit if s.unit else ''}, not {text!r}") from None
     return int(value) if value.is_integer() and s.type != "float32" and s.scale == 1.0 else value
 
 

@@ -7,8 +7,9 @@
     │                                  re-exported here
     └── PlcClientError                 base of everything else the client raises on purpose
         ├── UnknownSignalError         a name the map does not have ("did you mean ...?")
-        ├── SignalValueError           a value a signal cannot take
-        │   ├── ValueOutOfRangeError   outside the signal's range (names signal, value and range)
+        ├── SignalValueError           a value a signal cannot take (SignalSpec.check's refusals; SignalError)
+        │   ├── ValueTypeError         not a value of the signal's type (also a SignalTypeError)
+        │   ├── ValueOutOfRangeError   outside the signal's range (also a SignalRangeError; names the range)
         │   └── NotWritableError       the signal is an output of the twin
         ├── ModbusExceptionError       the server answered with a Modbus exception (code, address, unit)
         ├── ConnectionFailedError      no server at host:port, or the connection broke
@@ -22,11 +23,12 @@ from __future__ import annotations
 import difflib
 from collections.abc import Iterable
 
-from twin.core.errors import TwinError
+from twin.core.errors import SignalError, SignalRangeError, SignalTypeError, TwinError
 from twin.modbus.protocol import EXCEPTION_NAMES
 from twin.modbus.register_map import MapError
 
-__all__ = ["TwinError", "MapError", "PlcClientError", "UnknownSignalError", "SignalValueError", "ValueOutOfRangeError",
+__all__ = ["TwinError", "MapError", "PlcClientError", "UnknownSignalError", "SignalValueError", "ValueTypeError",
+           "ValueOutOfRangeError",
            "NotWritableError", "ModbusExceptionError", "ConnectionFailedError", "OutputRefusedError", "EXCEPTION_NAMES"]
 
 
@@ -34,29 +36,35 @@ class PlcClientError(TwinError):
     """Base class of the PLC client's own errors (a MapError is a TwinError beside it: see the tree above)."""
 
 
-class UnknownSignalError(PlcClientError, KeyError):
-    """A signal name that is not in the register map."""
+class UnknownSignalError(PlcClientError, SignalError, KeyError):
+    """A signal name that is not in the register map (a SignalError, as the twin's own for a name it lacks)."""
 
     def __init__(self, name: str, known: Iterable[str] = ()):
         self.signal = name
         self.suggestions = tuple(difflib.get_close_matches(name, list(known), n=3, cutoff=0.6))
         hint = f"; did you mean {self.suggestions[0]!r}?" if self.suggestions else \
             " (`plc map` lists the signals)"
-        super().__init__(f"unknown signal {name!r}{hint}")
+        Exception.__init__(self, f"unknown signal {name!r}{hint}")
 
     def __str__(self) -> str:  # KeyError would quote the message
         return self.args[0]
 
 
-class SignalValueError(PlcClientError, ValueError):
-    """A value a signal cannot take."""
+class SignalValueError(PlcClientError, SignalError, ValueError):
+    """A value a signal cannot take: the refusals of the one write validation (`SignalSpec.check`), raised
+    before anything is sent. Each kind is also the twin's own error class, so `except SignalRangeError`
+    catches the client's range refusal as it catches the twin's, the exchange's and the page's."""
 
     def __init__(self, name: str, message: str):
         self.signal = name
-        super().__init__(f"signal {name!r}: {message}")
+        Exception.__init__(self, f"signal {name!r}: {message}")
 
 
-class ValueOutOfRangeError(SignalValueError):
+class ValueTypeError(SignalValueError, SignalTypeError):
+    """A value of the wrong type (text for a number, 2 for a bit, NaN, a fraction for a whole number)."""
+
+
+class ValueOutOfRangeError(SignalValueError, SignalRangeError):
     """A value outside the signal's range (never clamped)."""
 
     def __init__(self, name: str, value: float, lo: float | None, hi: float | None, unit: str = ""):

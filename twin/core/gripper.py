@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 
 from .bullet import pybullet
 
-from .errors import SignalRangeError
 from .mechanism import JointInput, Mechanism
 from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # noqa: F401 (what the signals mean)
+from .signals import FLOAT, INPUT, SignalSpec
 from .station import GripperSpec
 from .world import COLLISION_MARGIN
 
@@ -184,17 +184,14 @@ class Gripper:
         return value
 
     @staticmethod
-    def check(inp: JointInput, value: float) -> None:
-        if not (inp.min <= value <= inp.max):
-            raise SignalRangeError(inp.name, value, inp.min, inp.max, inp.unit)
+    def check(inp: JointInput, value: float) -> float:
+        """The value as the input takes it, by the one write validation (`SignalSpec.check`: a range end sent
+        in other units is the end; out of range or not a finite number: rejected, never clamped)."""
+        return SignalSpec(inp.name, INPUT, FLOAT, inp.unit, inp.min, inp.max).check(value)
 
     def set_setpoint(self, name: str, value: float) -> None:
         """Validate and store a setpoint; it takes effect at the next step. Out of range: rejected."""
-        inp = self.mechanism.input(name)
-        slack = 1e-9 * max(1.0, abs(inp.min), abs(inp.max))  # a range end sent in other units (deg, mm) is the end
-        value = inp.max if inp.max < value <= inp.max + slack else inp.min if inp.min - slack <= value < inp.min else value
-        self.check(inp, value)
-        self.setpoint[name] = float(value)
+        self.setpoint[name] = self.check(self.mechanism.input(name), value)
 
     @property
     def limits(self) -> dict[str, tuple[float, float]]:

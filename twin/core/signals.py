@@ -91,7 +91,8 @@ class SignalSpec:
         lo = -math.inf if self.min is None else self.min
         hi = math.inf if self.max is None else self.max
         # a range end sent in other units (deg, mm) and converted back is the end, within a rounding's width
-        slack = 1e-9 * max(1.0, *(abs(v) for v in (self.min, self.max) if v is not None))
+        # (a whole number is exact: no slack)
+        slack = 0 if self.type == INT else 1e-9 * max(1.0, *(abs(v) for v in (self.min, self.max) if v is not None))
         if hi < value <= hi + slack:
             value = type(value)(hi)
         elif lo - slack <= value < lo:

@@ -26,26 +26,15 @@ import threading
 from collections import deque
 from collections.abc import Sequence
 
-from twin.core.errors import SignalError, SignalRangeError, SignalTypeError, TwinError
+from twin.core.errors import TwinError
 from twin.exchange import SimulationFault
 
 from .address_space import Variable
-from .errors import AdvanceRefused
+from .errors import AdvanceRefused, status_of  # status_of: the one mapping of a refused write to a status code
 
 log = logging.getLogger("twin.opcua")
 
 
-def status_of(exc: TwinError) -> str:
-    """The OPC UA status code for a write the exchange refused."""
-    if isinstance(exc, SimulationFault):
-        return "BadDeviceFailure"
-    if isinstance(exc, SignalRangeError):
-        return "BadOutOfRange"
-    if isinstance(exc, SignalTypeError):
-        return "BadTypeMismatch"
-    if isinstance(exc, SignalError):
-        return "BadNotWritable"
-    return "BadInternalError"
 
 
 class ServerThread:

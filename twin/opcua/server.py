@@ -516,15 +516,14 @@ def _validate(var: Variable, value) -> tuple[str | None, object]:
     spec = var.spec
     check = getattr(spec, "check", None)
     if check is not None:
-        from twin.core.errors import SignalRangeError
+        from twin.core.errors import TwinError
+
+        from .errors import status_of
 
         try:
             return None, check(value)
-        except SignalRangeError:
-            return "BadOutOfRange", None
-        except Exception as exc:  # SignalTypeError: the value does not fit the signal
-            name = type(exc).__name__
-            return ("BadTypeMismatch" if "Type" in name else "BadOutOfRange"), None
+        except TwinError as exc:  # by the error's type, as the exchange's refusals are
+            return status_of(exc), None
     if var.data_type == STRING:
         return (None, value) if value in spec.choices else ("BadOutOfRange", None)
     if var.data_type in LIMITS:

@@ -10,12 +10,12 @@ to the runner in the event loop's thread too. Nothing here steps the twin from a
 from __future__ import annotations
 
 import asyncio
-import math
 import signal
 import sys
 from pathlib import Path
 
-from twin.core.errors import SignalError, SignalRangeError, TwinError
+from twin.core.errors import TwinError
+from twin.core.signals import SignalSpec
 
 PAGE_START_TIMEOUT = 60.0  # s the cell waits for the page's process to listen before it runs without it
 
@@ -23,19 +23,11 @@ PAGE_START_TIMEOUT = 60.0  # s the cell waits for the page's process to listen b
 def check_write(spec: dict, value) -> str | None:
     """Why the twin would refuse `value` (SI) for the signal `spec` (a Scene signal), or None when it takes it.
 
-    The same rule and the same message as `Twin.write` (its errors are raised and their text returned)."""
-    name = spec["name"]
+    The one write validation, `SignalSpec.check`, so the same rule and the same message as `Twin.write`, the
+    exchange and every other front end (its error's text is the page's message)."""
     try:
-        if spec["direction"] != "input":
-            raise SignalError(name, "is an output of the twin and cannot be written")
-        if spec["type"] in ("float", "int"):
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
-                raise SignalError(name, f"needs a number, not {value!r}")
-            lo, hi = spec.get("min"), spec.get("max")
-            if lo is not None and hi is not None and not lo <= value <= hi:
-                raise SignalRangeError(name, value, lo, hi, spec.get("unit") or "")
-        if spec["type"] == "enum" and value not in spec.get("choices", ()):
-            raise SignalError(name, f"{value!r} is not one of {', '.join(repr(c) for c in spec['choices'])}")
+        SignalSpec(spec["name"], spec["direction"], spec["type"], spec.get("unit") or "", spec.get("min"),
+                   spec.get("max"), choices=tuple(spec.get("choices") or ())).check(value)
     except TwinError as exc:
         return str(exc)
     return None
