@@ -322,3 +322,59 @@ def test_the_same_station_gives_the_same_report(tmp_path, capsys):
     first = run_check(STATIONS / "smart_gripper", tmp_path, capsys)[2]
     second = run_check(STATIONS / "smart_gripper", tmp_path, capsys)[2]
     assert first == second
+
+
+def test_mesh_fingers_are_closed_the_way_their_shapes_come_together(tmp_path, capsys):
+    """pybullet_data's PR2 gripper: two revolute mesh fingers whose link frames sit on their pivots. Which way
+    closes them is asked of pybullet here (the fingers' bounding boxes, in a world of the test's own); the
+    doctor must grip the peg that way, and say so when the twin's own idea of closing differs."""
+    import pybullet
+    import pybullet_data
+
+    urdf = f"{pybullet_data.getDataPath()}/pr2_gripper.urdf"
+    c = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(urdf, physicsClientId=c)
+        names = {pybullet.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
+                 for j in range(pybullet.getNumJoints(body, physicsClientId=c))}
+        left, right = names["left_gripper_joint"], names["right_gripper_joint"]
+
+        def gap(q):
+            for j in (left, right):
+                pybullet.resetJointState(body, j, q, physicsClientId=c)
+            a, b = (pybullet.getAABB(body, j, physicsClientId=c) for j in (left, right))
+            return math.dist([(lo + hi) / 2 for lo, hi in zip(*a)], [(lo + hi) / 2 for lo, hi in zip(*b)])
+
+        closes_with = "decreasing" if gap(0.1) < gap(0.5) else "increasing"
+    finally:
+        pybullet.disconnect(c)
+    folder = tmp_path / "pr2"
+    folder.mkdir()
+    # the gripper points down (its x axis to -z), the finger tips 100 to 150 mm above the floor, a 150 mm peg
+    (folder / "station.toml").write_text("""[station]
+name = "pr2"
+
+[gripper]
+urdf = "pybullet_data:pr2_gripper.urdf"
+mount = { xyz = [0.0, 0.0, 0.42], rpy_deg = [0.0, 90.0, 0.0] }
+always_active = true
+initial = { left_gripper = 0.5, right_gripper = 0.5 }
+
+[[targets]]
+name = "peg"
+shape = "box"
+size = [0.02, 0.02, 0.15]
+xyz = [0.0, 0.0, 0.075]
+density = 1000.0
+
+[[fixtures]]
+name = "floor"
+shape = "plane"
+""")
+    code, text, report = run_check(folder, tmp_path, capsys)
+    consistent_exit(code, text)
+    g = grip(report, "peg", "outside")
+    assert not g["skipped"], text
+    assert all(f["onset_step"] is not None for f in g["fingers"]), text
+    for line in (ln for ln in text.splitlines() if " closing: " in ln):
+        assert line.startswith("FAIL") and f"close with {closes_with}" in line, line
