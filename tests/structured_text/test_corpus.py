@@ -55,6 +55,8 @@ KNOWN_BUGS: dict[str, str] = {
     "cli/set_out_of_range.st": "st-bugs.md #8: --set wraps a value out of the variable's range",
     "cli/set_wrong_kind.st": "st-bugs.md #9: --set of a number to a BOOL accepted",
     "cli/negative_duration.st": "st-bugs.md #10: plc run --for -1 runs nothing and exits 0",
+    "errors/unknown_type.st": "st-bugs.md #11: a variable of an unknown type gives a second, wrong error",
+    "errors/subscript_count.st": "st-bugs.md #12: 'indexed with 2' reported at the first subscript",
 }
 
 REAL_TOLERANCE = 1e-6
