@@ -36,7 +36,7 @@ IK_FAIL_ORI = math.radians(0.1)
 RESTART_POSES = ((0, 0, 0, 90, 0), (30, 30, 0, 30, 0), (-20, -60, 0, 60, 0), (0, 0, 0, -60, 0), (20, 0, 180, 60, 0))
 RESTART_ITERATIONS = 15
 #: Without acceleration limits from the station, an axis reaches its top speed in this time (s).
-DEFAULT_ACCEL_TIME = 0.5
+DEFAULT_ACCEL_TIME = 0.25
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,72 @@
+"""The motion planner on an arm nobody tuned: the shipped arm's URDF with every axis at a different speed limit,
+acceleration limits from the station, zones blended through the twin's API (no RAPID). Checked against the
+URDF's limits and the corner's geometry, measured on the physics arm."""
+import math
+
+import numpy as np
+import pytest
+
+from tests.core.test_foreign_models import ARM, robot_station
+from twin.core import Twin
+from twin.core.geometry import Pose
+from twin.core.motion import Speed
+from twin.core.planner import FINE, Zone
+
+SPEEDS = [0.9, 1.3, 1.1, 2.0, 2.4, 3.0]  # rad/s, our arm's (the shipped one's are 1.92 to 4.1)
+ACCEL_DEG = [150.0, 220.0, 180.0, 400.0, 300.0, 500.0]
+
+
+@pytest.fixture
+def twin(tmp_path):
+    text = ARM.read_text()
+    for i, v in enumerate(SPEEDS, start=1):
+        start = text.index(f'<joint name="joint_{i}"')
+        limit = text.index("velocity=", start)
+        end = text.index('"', limit + len('velocity="'))
+        text = text[:limit] + f'velocity="{v}' + text[end:]
+    arm = tmp_path / "slow_arm.urdf"
+    arm.write_text(text)
+    with Twin.from_station(robot_station(tmp_path, arm, f"accel_deg = {ACCEL_DEG}")) as t:
+        yield t
+
+
+def down(x, y, z):
+    return Pose.from_xyz_rpy((x, y, z), (math.pi, 0.0, 0.0))
+
+
+def run(twin):
+    t, p = [], []
+    while twin.robot_busy:
+        twin.step()
+        t.append(twin.time)
+        p.append(twin.tcp_pose().position.copy())
+    return np.array(t), np.array(p)
+
+
+def test_a_moveabsj_takes_what_its_slowest_axis_needs_at_this_arms_limits(twin):
+    start = twin.robot_q
+    goal = start + np.radians([70.0, 10.0, -15.0, 90.0, 20.0, 100.0])
+    t0 = twin.time
+    twin.move("MoveAbsJ", goal, Speed(v_tcp=10.0, v_ori=10.0))
+    run(twin)
+    duration = twin.time - t0
+    travel, v, a = np.abs(goal - start), np.array(SPEEDS), np.radians(ACCEL_DEG)
+    assert duration >= max(travel / v)
+    trapezoid = np.where(travel >= v ** 2 / a, travel / v + v / a, 2 * np.sqrt(travel / a))
+    assert duration == pytest.approx(max(trapezoid), rel=0.2)
+    assert np.allclose(twin.robot_q, goal, atol=1e-3)
+
+
+def test_zones_blend_on_this_arm_within_the_zone_and_without_stopping(twin):
+    twin.run_motion("MoveJ", down(1.5, -0.3, 0.7), 1.0)
+    corners = [(1.8, -0.3, 0.7), (1.8, 0.2, 0.7), (1.5, 0.2, 0.7)]
+    z = Zone(False, 0.03, 0.045, 0.045, math.radians(4.5))  # z30
+    for i, c in enumerate(corners):
+        twin.move("MoveL", down(*c), Speed(v_tcp=0.4), zone=z if i < 2 else FINE)
+    t, p = run(twin)
+    v = np.concatenate([[0.0], np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(t)])
+    for c in corners[:2]:
+        d = np.linalg.norm(p - c, axis=1)
+        assert v[d < 0.035].min() > 0.1  # through the corner at speed
+        assert 0.002 < d.min() < 0.03 / math.sqrt(2)  # cut, inside the chord of the zone
+    assert np.linalg.norm(p[-1] - corners[2]) < 0.0005
