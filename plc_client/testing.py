@@ -109,23 +109,25 @@ def twin_command() -> list[str]:
 @contextlib.contextmanager
 def twin_server(station: str | Path, *, lockstep: bool = True, speed: float | None = None, host: str = LOOPBACK,
                 port: int = 0, unit_id: int = 1, startup_timeout: float = 30.0,
-                extra_args: list[str] = (), faults: str | Path | None = None) -> Iterator[TwinServer]:
+                extra_args: list[str] = (), faults: str | Path | None = None, layout: str = "") -> Iterator[TwinServer]:
     """Start `twin serve STATION` on loopback, wait until it listens, and stop it afterwards.
 
     port 0 (the default): the server binds a free port and says which (no race with other tests).
     lockstep: the server only steps when told (`sim.advance`): the same run gives the same result. Else it
     runs in real time, or at `speed` times real time. `faults`: a faults file (`[faults.NAME]` tables as in a
-    campaign, docs/campaigns.md) whose plant faults the served twin meets (`twin serve --faults`).
+    campaign, docs/campaigns.md) whose plant faults the served twin meets (`twin serve --faults`). `layout`:
+    the register map's (`twin serve --layout`; "plc" for a PLC with located variables).
     """
     station = Path(station)
-    rmap = RegisterMap.from_station(station)
+    rmap = RegisterMap.from_station(station, layout)
     mode = ["--lockstep"] if lockstep else ["--realtime", *(["--speed", f"{speed:g}"] if speed else [])]
     with tempfile.NamedTemporaryFile(mode="w+", prefix="twin-serve-", suffix=".log", delete=False) as log:
         log_path = Path(log.name)
         events_path = log_path.with_suffix(".events.jsonl")
         proc = subprocess.Popen([*twin_command(), "serve", str(station), "--host", host, "--port", str(port),
                                  "--unit-id", str(unit_id), *mode, "--events", str(events_path),
-                                 *(["--faults", str(faults)] if faults else []), *extra_args],
+                                 *(["--faults", str(faults)] if faults else []),
+                                 *(["--layout", layout] if layout else []), *extra_args],
                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=log)
     server = None
     try:

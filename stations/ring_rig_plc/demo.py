@@ -1,7 +1,7 @@
 """The main job: the ring rig's full automatic cycle with its gripper PLC on the other side of the network.
 (This station's `plc demo`, named in its station.toml's [plugins]; `python3 tasks.py demo` runs it.)
 
-    plc demo [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE] [--faults FILE] [--station DIR]
+    plc demo [--plc st|python] [--cycles N] [--realtime [--speed X]] [--remove-ring CYCLE] [--faults FILE] [--station DIR]
 
 It starts `twin serve` for `stations/ring_rig_plc` as a subprocess (the twin and its RAPID robot
 controller), connects a scan-cycle PLC to it over Modbus/TCP, and runs as the cell's operator: it sets
@@ -24,6 +24,10 @@ Exit status: 0 when every cycle was done and the ring is back within 5 mm of whe
 --remove-ring, 0 when the injected miss was detected and the robot stopped the cycle; with --faults, 0
 when the cycles were done as without it, or the PLC reported a fault and the robot stopped the cycle; 1 otherwise;
 2 for bad arguments or a station the demo cannot run.
+
+The gripper PLC is `gripper.st` (the default, `--plc st`: Structured Text in the project's ST runtime, its
+located variables bound through the twin's PLC layout, `twin serve --layout plc`, as on a real Modbus master
+PLC) or `plc_logic.py` (`--plc python`); both run the same careful grip sequence.
 
 Lockstep (the default): the PLC advances the twin one scan at a time, so the run is repeatable to the
 bit and runs as fast as the machine allows. `--realtime`: the twin runs against the wall clock (at
@@ -51,6 +55,8 @@ from stations.ring_rig_plc import plc_logic as ring_rig
 # early keeps pytest from rewriting it when a test suite loads it as a plugin (PytestAssertRewriteWarning).
 
 DEFAULT_STATION = Path(__file__).resolve().parent
+ST_FILES = ("gripper.st", "io.st")  # the ST gripper PLC and its generated declarations, beside this file
+PLCS = ("st", "python")
 CYCLE_LIMIT_S = 120.0  # simulated seconds one cycle may take before the demo gives up
 RING_OK_MM = 5.0  # a cycle puts the ring back within this of where it started
 
@@ -130,7 +136,7 @@ class CellDemo:
     def __init__(self, station: str | Path = DEFAULT_STATION, cycles: int = 1, *, realtime: bool = False,
                  speed: float = 1.0, remove_ring_at: int | None = None, scan_cycle: float = 0.010,
                  out: Callable[[str], None] | None = None, record: str | Path | None = None,
-                 faults: str | Path | None = None):
+                 faults: str | Path | None = None, plc: str = "python"):
         if cycles < 1:
             raise ValueError("at least one cycle")
         if not (speed > 0 and scan_cycle > 0):
@@ -143,7 +149,10 @@ class CellDemo:
         self.now = 0.0  # simulated s, as last read from the server
         self.scans = 0  # PLC scans of the last run
         self.requests = 0  # Modbus requests the PLC sent in the last run
-        self.grip = ring_rig.cell_sequence()  # the gripper PLC
+        if plc not in PLCS:
+            raise ValueError(f"the gripper PLC is one of {', '.join(PLCS)}, not {plc!r}")
+        self.plc = plc
+        self.grip = ring_rig.cell_sequence()  # the gripper PLC (--plc python), and the numbers the narration uses
         self.record = record  # twin serve --record FILE: every signal and body pose at every step
         self.faults = None if faults is None else Path(faults)  # twin serve --faults FILE: plant faults
 
@@ -168,14 +177,19 @@ class CellDemo:
         if ring is None:
             raise DemoError(f"{self.station}: the demo needs a target 'ring' (its cell is stations/ring_rig_plc)")
         start_xyz = ring.pose.xyz
-        logic = Combined(self.grip, operator(self.cycles, self.remove_ring_at))
         mode = "lockstep: the PLC steps the twin" if not self.realtime else f"real time x{self.speed:g}"
         self.out(f"demo: {self.station.name}, {self.cycles} cycle(s), {mode}, PLC scan {self.scan_cycle * 1000:g} ms")
+        if self.plc == "st":
+            self.out(f"demo: the gripper PLC is {' + '.join(ST_FILES)} (Structured Text, located variables on the "
+                     "twin's PLC layout; --plc python runs plc_logic.py)")
+        else:
+            self.out("demo: the gripper PLC is plc_logic.py (Python; --plc st runs gripper.st)")
         extra = ["--record", str(self.record)] if self.record is not None else []
         if self.faults is not None:
             self.out(f"demo: the twin meets the faults of {self.faults}")
         with twin_server(self.station, lockstep=not self.realtime, speed=None if not self.realtime else self.speed,
-                         extra_args=extra, faults=self.faults) as server:
+                         extra_args=extra, faults=self.faults, layout="plc" if self.plc == "st" else "") as server:
+            logic = Combined(self._gripper_plc(server.map), operator(self.cycles, self.remove_ring_at))
             missing = [n for n in dict.fromkeys((*logic.inputs, *logic.outputs, *WATCH)) if n not in server.map]
             if missing:
                 raise DemoError(f"{self.station}: not a cell the demo can run: it has no {', '.join(missing)} "
@@ -185,10 +199,22 @@ class CellDemo:
             with server.client() as client:
                 return self._run(server, client, start_xyz, logic)
 
+    def _gripper_plc(self, rmap):
+        """The gripper PLC's logic: the Python sequence, or gripper.st bound through the map's PLC layout."""
+        if self.plc == "python":
+            return self.grip
+        from plc_client.st_io import StLogic
+
+        logic = StLogic([DEFAULT_STATION / f for f in ST_FILES], rmap)
+        probe = logic.initial_state()
+        get = lambda n: float(probe.get(f"{logic.instance}.{n}"))  # noqa: E731
+        self.grip = StNumbers(speed=get("SPEED"), threshold=get("THRESHOLD"), travel=(get("TRAVEL_LOW"), get("TRAVEL_HIGH")))
+        return logic
+
     def _run(self, server, client, start_xyz, logic) -> Summary:
         plc = ScanCycle(ClientIO(client, lockstep=not self.realtime), logic, cycle=self.scan_cycle,
                         inputs=tuple(dict.fromkeys((*logic.inputs, *WATCH))), speed=self.speed if self.realtime else 1.0)
-        grip_state = plc.state[0]
+        grip_state = plc.state[0] if self.plc == "python" else StGripView(logic.logics[0], plc.state[0])
         events = server.events  # written as they happen: a scan's answer comes after its steps' events
         s = Summary(self.cycles, remove_ring_at=self.remove_ring_at, faults=None if self.faults is None else str(self.faults))
         cpu0 = (time.process_time(), _process_cpu(server.process.pid))
@@ -322,6 +348,67 @@ class CellDemo:
 FINGER_FAULTS = (Fault.JAMMED, Fault.DRIVE_LOST, Fault.FORCE_READING)
 
 
+@dataclass(frozen=True)
+class StNumbers:
+    """The ST PLC's constants the narration quotes (the Python sequence's attributes of the same names)."""
+
+    speed: float
+    threshold: float
+    travel: tuple[float, float]
+
+
+class StGripView:
+    """gripper.st's sequence as the narration reads the Python one's state (`plc_logic.CarefulState`): its
+    program variables phase, fault_code, inside, goal, force[], ready_at, fault_axis, fault_lag, fault_effort."""
+
+    def __init__(self, logic, plc):
+        self.logic, self.plc = logic, plc
+        self._refs = {}
+
+    def _get(self, name: str):
+        ref = self._refs.get(name)
+        if ref is None:
+            ref = self._refs[name] = self.plc.resolve(f"{self.logic.instance}.{name}")
+        return ref.get()
+
+    @property
+    def phase(self) -> Phase:
+        return Phase(int(self._get("phase")))
+
+    @property
+    def fault(self) -> Fault:
+        return Fault(int(self._get("fault_code")))
+
+    @property
+    def mode(self) -> str:
+        return INSIDE if self._get("inside") else "outside"
+
+    @property
+    def goal(self) -> float:
+        return float(self._get("goal"))
+
+    @property
+    def forces_at_grip(self) -> dict:
+        return {f: float(self._get(f"force[{i}]")) for i, f in enumerate(ring_rig.FORCES, start=1)}
+
+    @property
+    def refused(self) -> float:
+        return float(self._get("ready_at"))
+
+    @property
+    def fault_axis(self) -> str:
+        i = int(self._get("fault_axis"))
+        return ring_rig.AXES[i - 1] if 1 <= i <= len(ring_rig.AXES) else "?"
+
+    @property
+    def fault_lag(self) -> float:
+        return float(self._get("fault_lag"))
+
+    @property
+    def fault_effort(self) -> float:
+        return float(self._get("fault_effort"))
+
+
 def finger_fault_text(st) -> str:
     """What the PLC found wrong with a finger, from its grip state (`plc_logic.CarefulState`)."""
     what = {Fault.JAMMED: "jammed (its drive pushes, it does not move)",
@@ -376,7 +463,7 @@ def main(args) -> int:
 
     demo = CellDemo(args.station, args.cycles, realtime=args.realtime, speed=args.speed,
                     remove_ring_at=args.remove_ring, scan_cycle=args.scan, record=record, out=out,
-                    faults=args.faults)
+                    faults=args.faults, plc=args.plc)
     summary = demo.run()
     if args.report is not None:
         report(record, args.report, threshold=demo.grip.threshold, narration=lines,
@@ -401,6 +488,8 @@ def add_arguments(p) -> None:
 
     p.description, p.epilog = __doc__.split("\n\n")[2], EXIT_STATUS_HELP
     p.formatter_class = argparse.RawDescriptionHelpFormatter
+    p.add_argument("--plc", choices=PLCS, default="st",
+                   help="the gripper PLC: st, gripper.st in Structured Text (the default), or python, plc_logic.py")
     p.add_argument("--cycles", type=positive_int, metavar="N", default=1, help="full cycles to run (default 1)")
     p.add_argument("--realtime", action="store_true", help="run the twin against the wall clock (default: lockstep)")
     p.add_argument("--speed", type=positive_float, metavar="X", default=1.0, help="with --realtime: X times real time (default 1)")

@@ -102,3 +102,15 @@ def test_the_demo_command_prints_its_steps_and_a_summary(tmp_path):
     m = re.search(r"ring\s+(\d+\.\d) mm from its start", summary)
     assert m and float(m.group(1)) < 2.0
     check_demo_report(out.stdout, tmp_path / "report")  # the report the demo ends with (tests/view)
+
+
+@pytest.mark.skipif(not (ROOT / "structured_text" / "runtime.py").exists(), reason="the ST runtime has not landed")
+def test_the_gripper_plc_in_structured_text_runs_the_same_cycle(one_cycle):
+    """`plc demo` (--plc st, the default): gripper.st over Modbus against `twin serve --layout plc`, its located
+    variables bound through the map's device ranges. The same cycle as the Python PLC's, line for line."""
+    s, lines = run_cell(cycles=1, plc="st")
+    assert s.cycles_done == 1 and s.grips == 2 and s.misses == 0 and not s.stopped
+    assert s.ring_error_mm is not None and s.ring_error_mm < 2.0
+    assert any("the gripper PLC is gripper.st + io.st (Structured Text" in line for line in lines)
+    assert narration(lines) == narration(one_cycle[1])
+    assert (s.ring_end, s.cycle_sim) == (one_cycle[0].ring_end, one_cycle[0].cycle_sim)
