@@ -50,6 +50,11 @@ def parse(source: str, file: str = "<input>") -> n.Module:
     return Parser(lex(source, file), source, file).module()
 
 
+# RobotStudio's and the FlexPendant's placeholders for a slot still to be filled in, by what the slot holds
+_PLACEHOLDERS = {"SMT": "statement", "EXP": "expression", "ARG": "argument", "ID": "name", "VAR": "variable",
+                 "DN": "data name", "TDN": "data type", "CSE": "CASE", "PAR": "parameter", "DIM": "dimension"}
+
+
 class Parser:
     def __init__(self, tokens: list[Token], source: str, file: str):
         self.toks = tokens
@@ -79,7 +84,18 @@ class Parser:
         return t
 
     def error(self, message: str, span: Span | None = None) -> ParseError:
+        placeholder = self.placeholder() if span is None else None
+        if placeholder:
+            message = (f"{placeholder} is a placeholder RobotStudio's editor left in the program (an empty "
+                       f"{_PLACEHOLDERS[placeholder[1:-1].upper()]} slot): write what belongs there, or delete it")
         return ParseError(message, span or self.tok.span)
+
+    def placeholder(self) -> str | None:
+        """`<SMT>`, `<EXP>`, ... at the current token: an editor's empty slot, never valid RAPID."""
+        t, word, close = self.tok, self.peek(1), self.peek(2)
+        if t.is_op("<") and word.kind in (Kind.IDENT, Kind.KEYWORD) and word.upper in _PLACEHOLDERS and close.is_op(">"):
+            return f"<{word.text}>"
+        return None
 
     def after_previous(self) -> Span:
         """The position just after the previous token (where a missing ';' belongs)."""
