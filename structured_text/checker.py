@@ -773,11 +773,15 @@ class Checker:
             if info.kind != "FUNCTION":
                 raise self.fail(f"'{c.name}' is a {info.kind} type: call an instance of it", c.span)
             c.target = ("fn", info)
+            self.en_eno(c, scope, statement)
             self.bind_args(c, info.params, scope, f"function {info.name}")
             return info.result
         if up in STANDARD_FBS:
             raise self.fail(f"'{c.name}' is a function block type: declare an instance (t1 : {up};) and call it", c.span)
         if stdlib_fn.is_standard(up):
+            self.en_eno(c, scope, statement)
+            if c.eno is not None:
+                raise self.fail("ENO of a standard function is not supported", c.eno.span)
             return self.std_call(c, up, scope, expected)
         if up in ("ADR", "REF", "SIZEOF", "ADRINST", "__NEW", "__DELETE"):
             raise self.fail(f"{up}: pointers and references are not supported", c.span)
@@ -788,9 +792,32 @@ class Checker:
             raise self.fail(f"a function block call is a statement, not a value (call it, then read its outputs: "
                             f"{c.name}.Q)", c.span)
         c.target = ("fb", fbt)
+        self.en_eno(c, scope, statement)
         params = [s for s in fbt.members.values() if s.section in ("VAR_INPUT", "VAR_IN_OUT", "VAR_OUTPUT")]
         self.bind_args(c, params, scope, f"{fbt.name} instance")
         return ty.BOOL
+
+    def en_eno(self, c: n.Call, scope: _Scope, statement: bool) -> None:
+        """The standard's EN input and ENO output of a call: taken out of the arguments (c.en, c.eno).
+        EN FALSE: the call does not run (a function gives its type's default), ENO FALSE."""
+        c.en = c.eno = None
+        rest = []
+        for a in c.args:
+            name = (a.name or "").upper()
+            if name == "EN" and not a.output:
+                if self.expr(a.value, scope, ty.BOOL).kind != "bool":
+                    raise self.fail("EN is a BOOL", a.value.span)
+                c.en = a.value
+            elif name == "ENO" and a.output:
+                if not statement:
+                    raise self.fail("ENO of a call inside an expression is not supported: call it as a statement",
+                                    a.span)
+                if self.lvalue(a.value, scope).kind != "bool":
+                    raise self.fail("ENO is a BOOL", a.value.span)
+                c.eno = a.value
+            else:
+                rest.append(a)
+        c.args = rest
 
     def bind_args(self, c: n.Call, params: list[Symbol], scope: _Scope, what: str) -> None:
         by_name = {p.name.upper(): p for p in params}

@@ -117,6 +117,8 @@ def _run(args) -> int:
     if args.duration is None:
         raise UsageError("--for SECONDS is required")
     duration = seconds(args.duration)
+    if not duration > 0:
+        raise UsageError(f"--for {args.duration}: the run's length is greater than 0 s")
     sources = _load_files(args.files)
     try:
         compiled = compile_files(args.files, sources)

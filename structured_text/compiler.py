@@ -224,8 +224,10 @@ class Compiler:
         if isinstance(st, n.Assign):
             if isinstance(st.value, n.Call) and st.value.target and st.value.target[0] == "fn" and \
                     self.has_outputs(st.value.target[1]):
-                r = self.call_with_outputs(st.value)
-                self.assign(st.target, r, st.value.ty, fits=False)
+                def call():
+                    r = self.call_with_outputs(st.value)
+                    self.assign(st.target, r, st.value.ty, fits=False)
+                self.guarded(st.value, call)
                 return
             code, fits = self.expr(st.value)
             self.assign(st.target, code, st.value.ty, fits)
@@ -234,9 +236,12 @@ class Compiler:
             if c.target[0] == "fb":
                 self.fb_call(c)
             elif c.target[0] == "fn" and self.has_outputs(c.target[1]):
-                self.call_with_outputs(c)
+                self.guarded(c, lambda: self.call_with_outputs(c))
             else:
-                o.emit(self.expr(c)[0])
+                en, c.en = c.en, None
+                code = self.expr(c)[0]
+                c.en = en
+                self.guarded(c, lambda: o.emit(code))
         elif isinstance(st, n.If):
             for k, (cond, body) in enumerate(st.branches):
                 o.emit(f"{'if' if k == 0 else 'elif'} {self.expr(cond)[0]}:")
@@ -422,7 +427,27 @@ class Compiler:
     def has_outputs(self, info: PouInfo) -> bool:
         return any(s.section in ("VAR_OUTPUT", "VAR_IN_OUT") for s in info.params)
 
+    def guarded(self, c: n.Call, emit_call) -> None:
+        """The call under its EN (if given), then ENO := EN."""
+        o = self.out
+        if c.en is None:
+            emit_call()
+            if c.eno is not None:
+                self.assign(c.eno, "True", ty.BOOL, True)
+            return
+        en = o.temp("en")
+        o.emit(f"{en} = {self.expr(c.en)[0]}")
+        o.emit(f"if {en}:")
+        o.level += 1
+        emit_call()
+        o.level -= 1
+        if c.eno is not None:
+            self.assign(c.eno, en, ty.BOOL, True)
+
     def fb_call(self, c: n.Call) -> None:
+        self.guarded(c, lambda: self._fb_call(c))
+
+    def _fb_call(self, c: n.Call) -> None:
         o = self.out
         inst = self.expr(c.instance)[0]
         if not inst.replace(".", "").replace("_", "").isalnum():
@@ -616,6 +641,12 @@ class Compiler:
         return code, False
 
     def call_expr(self, c: n.Call) -> tuple[str, bool]:
+        if getattr(c, "en", None) is not None:  # EN FALSE: the function does not run, its result is the default
+            en = c.en
+            c.en = None
+            code, fits = self.call_expr(c)
+            c.en = en
+            return f"({code} if {self.expr(en)[0]} else {self.initial(c.ty, None)})", fits
         kind = c.target[0]
         if kind == "fn":
             info = c.target[1]

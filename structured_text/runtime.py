@@ -478,14 +478,38 @@ def _describe(exc: BaseException) -> str:
 
 
 def coerce(t: ty.DataType, value):
-    """A value from outside (the command line, a binding) as a value of type t."""
+    """A value from outside as a value of type t: text (the command line) must be a literal the type holds
+    (ValueError naming what it needs, never a silent wrap); Python values (a binding) are converted."""
     k = t.kind
     if isinstance(value, str):
+        return _from_text(t, value)
+    if k == "bool":
+        return bool(value)
+    if k in ("int", "bits"):
+        if isinstance(value, float):
+            value = round(value)
+        if isinstance(t, ty.SubrangeT):
+            return int(value)
+        return ty.wrap(t, int(value))
+    if k == "real":
+        return ty.to_f32(float(value)) if t.bits == 32 else float(value)
+    if k in ("time", "date", "tod", "dt"):
+        return int(value)
+    if k == "string":
+        return str(value)
+    return value
+
+
+def _from_text(t: ty.DataType, value: str):
+    k = t.kind
+    if True:
         from .lexer import lex
         text = value.strip()
         up = text.upper()
-        if k == "bool" and up in ("TRUE", "FALSE", "1", "0"):
-            return up in ("TRUE", "1")
+        if k == "bool":
+            if up.removeprefix("BOOL#") in ("TRUE", "FALSE", "1", "0"):
+                return up.removeprefix("BOOL#") in ("TRUE", "1")
+            raise ValueError(f"{text!r} is not a BOOL: give TRUE or FALSE")
         if k == "string":
             return text[1:-1] if len(text) >= 2 and text[0] == text[-1] == "'" else text
         if k == "enum":
@@ -505,20 +529,20 @@ def coerce(t: ty.DataType, value):
             raise ValueError(f"{text!r} is not a value")
         lit = toks[0].value
         value = -lit.value if neg else lit.value
-        if lit.category in ("time", "date", "tod", "dt") and k != lit.category:
-            raise ValueError(f"{text!r} is not a {t}")
-    if k == "bool":
-        return bool(value)
-    if k in ("int", "bits"):
-        if isinstance(value, float):
-            value = round(value)
-        if isinstance(t, ty.SubrangeT):
-            return int(value)
-        return ty.wrap(t, int(value))
-    if k == "real":
-        return ty.to_f32(float(value)) if t.bits == 32 else float(value)
-    if k in ("time", "date", "tod", "dt"):
-        return int(value)
-    if k == "string":
-        return str(value)
-    return value
+        cat = lit.category
+        if k in ("int", "bits"):
+            if cat != "int":
+                raise ValueError(f"{text!r} is not an integer ({t} needs one)")
+            lo, hi = ty.range_of(t)
+            if not lo <= value <= hi:
+                raise ValueError(f"{text} is out of the range of {t} ({lo}..{hi})")
+            return value
+        if k == "real":
+            if cat not in ("int", "real"):
+                raise ValueError(f"{text!r} is not a number ({t} needs one)")
+            return ty.to_f32(float(value)) if t.bits == 32 else float(value)
+        if k in ("time", "date", "tod", "dt"):
+            if cat != k:
+                raise ValueError(f"{text!r} is not a {t} literal (e.g. T#200ms, D#2024-01-31, TOD#12:00:00)")
+            return value
+        raise ValueError(f"{text!r} cannot be given to a {t}")

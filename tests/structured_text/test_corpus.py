@@ -52,9 +52,6 @@ RUNTIME_PRESENT = _runtime_present()
 # Cases that fail because of a runtime bug not fixed yet: path -> the entry of /work/team/st-bugs.md.
 # Strict: once the runtime is fixed the xfail turns into a failure, and the entry here must go.
 KNOWN_BUGS: dict[str, str] = {
-    "cli/set_out_of_range.st": "st-bugs.md #8: --set wraps a value out of the variable's range",
-    "cli/set_wrong_kind.st": "st-bugs.md #9: --set of a number to a BOOL accepted",
-    "cli/negative_duration.st": "st-bugs.md #10: plc run --for -1 runs nothing and exits 0",
     "errors/unknown_type.st": "st-bugs.md #11: a variable of an unknown type gives a second, wrong error",
     "errors/subscript_count.st": "st-bugs.md #12: 'indexed with 2' reported at the first subscript",
 }

@@ -259,3 +259,23 @@ END_PROGRAM
     assert plc.get("t") == 750 * MS  # (1.5 s x 2) / 4
     assert plc.get("w") == 0x1234 and plc.get("i") == 987  # one decimal digit per nibble
     assert plc.resolve("d").json() == "DT#2024-01-01-01:00:00"
+
+
+def test_en_eno_skip_a_call_and_say_so(tmp_path):
+    # EN FALSE: the block or function does not run, ENO is FALSE (a function gives its type's default)
+    plc = plc_of(tmp_path, """
+FUNCTION Inc : INT
+VAR_INPUT x : INT; END_VAR
+Inc := x + 1;
+END_FUNCTION
+PROGRAM main
+VAR c : CTU; go, ok : BOOL; a : INT := 7; END_VAR
+c(EN := go, CU := TRUE, PV := 3, ENO => ok);
+a := Inc(EN := go, x := 10);
+END_PROGRAM
+""")
+    plc.scan_ns(0)
+    assert (plc.get("c.CV"), plc.get("ok"), plc.get("a")) == (0, False, 0)
+    plc.set("go", True)
+    plc.scan_ns(10 * MS)
+    assert (plc.get("c.CV"), plc.get("ok"), plc.get("a")) == (1, True, 11)
