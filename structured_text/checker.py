@@ -99,6 +99,13 @@ class _Scope:
         return self.checker.globals.get(up)
 
 
+class _Quiet(CheckError):
+    """A follow-on of an error already reported (a use of a variable whose type was unknown): not reported."""
+
+
+ERROR_TYPE = ty.Elementary("<error>", "error")
+
+
 def check(files: list[n.SourceFile]) -> Program:
     return Checker(files).run()
 
@@ -121,6 +128,8 @@ class Checker:
     def guard(self, fn, *args):
         try:
             return fn(*args)
+        except _Quiet:
+            return None
         except CheckError as exc:
             self.errors.append(exc)
             return None
@@ -165,6 +174,7 @@ class Checker:
         for info in self.pous.values():
             self.check_body(info)
         tasks, instances, conf_name = self.configuration(configs)
+        self.errors = [e for e in self.errors if not isinstance(e, _Quiet)]
         if self.errors:
             self.errors.sort(key=lambda e: (e.span.file, e.span.line, e.span.col) if e.span else ("", 0, 0))
             raise StaticErrors(self.errors)
@@ -299,7 +309,11 @@ class Checker:
             s = Symbol(d.name, t, d.section, d.span, d.constant)
             info.symbols[up] = s
             return
-        t = self.type_of(d.spec, scope)
+        try:
+            t = self.type_of(d.spec, scope)
+        except CheckError:
+            info.symbols[up] = Symbol(d.name, ERROR_TYPE, d.section, d.span)  # its uses say nothing more
+            raise
         kind = info.kind
         if t.kind in ("fb", "program"):
             if t.kind == "program":
@@ -579,6 +593,8 @@ class Checker:
 
     def expr(self, e: n.Expr, scope: _Scope, expected: ty.DataType | None = None) -> ty.DataType:
         t = self._expr(e, scope, expected)
+        if t is ERROR_TYPE:
+            raise _Quiet("", e.span)
         e.ty = t
         return t
 
@@ -630,7 +646,7 @@ class Checker:
                 raise self.fail(f"a {bt} cannot be indexed", e.indexes[0].span)
             if len(e.indexes) != len(bt.dims):
                 raise self.fail(f"the array has {len(bt.dims)} dimension{'s' if len(bt.dims) > 1 else ''}, "
-                                f"indexed with {len(e.indexes)}", e.indexes[0].span)
+                                f"indexed with {len(e.indexes)}", e.span)
             for ix, (lo, hi) in zip(e.indexes, bt.dims):
                 it = self.expr(ix, scope, ty.DINT)
                 if it.kind not in ("int", "bits"):
@@ -762,6 +778,8 @@ class Checker:
         s = scope.lookup(c.name)
         up = c.name.upper()
         if s is not None:
+            if s.type is ERROR_TYPE:
+                raise _Quiet("", c.span)
             if s.type.kind == "fb":
                 inst = n.Name(c.span, c.name)
                 self.expr(inst, scope)

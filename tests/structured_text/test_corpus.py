@@ -52,8 +52,6 @@ RUNTIME_PRESENT = _runtime_present()
 # Cases that fail because of a runtime bug not fixed yet: path -> the entry of /work/team/st-bugs.md.
 # Strict: once the runtime is fixed the xfail turns into a failure, and the entry here must go.
 KNOWN_BUGS: dict[str, str] = {
-    "errors/unknown_type.st": "st-bugs.md #11: a variable of an unknown type gives a second, wrong error",
-    "errors/subscript_count.st": "st-bugs.md #12: 'indexed with 2' reported at the first subscript",
 }
 
 REAL_TOLERANCE = 1e-6
