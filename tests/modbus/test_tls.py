@@ -94,3 +94,25 @@ def test_tls_only_does_not_listen_on_plain_tcp_and_missing_files_are_errors(pki,
     r = subprocess.run([sys.executable, "-m", "twin", "serve", str(RING_BENCH), "--tls-cert", str(pki["server"]),
                         "--tls-key", str(pki["server_key"])], capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "missing --tls-ca" in r.stderr
+
+
+def test_the_certificate_role_grants_read_and_write_or_read_only(pki, tls_server):
+    """The Modbus/TCP Security role extension: an Operator writes, a Viewer only reads (exception 01 for a
+    write, as the specification's role-based authorization and --read-only refuse), an unknown role only reads."""
+    write = pdu(6, 16, 33000)  # L2 = 330 mm (holding register 16, 0.01 mm per count)
+    assert tls_request(pki, tls_server.tls_port, "operator", write) == write  # echoed: accepted
+    assert tls_request(pki, tls_server.tls_port, "viewer", write) == b"\x86\x01"  # ILLEGAL FUNCTION
+    assert tls_request(pki, tls_server.tls_port, "viewer", pdu(3, 16, 1)) == b"\x03\x02" + struct.pack(">H", 33000)
+    assert tls_request(pki, tls_server.tls_port, "janitor", write) == b"\x86\x01"
+    assert tls_request(pki, tls_server.tls_port, "client", write) == write  # no role: as the server is (read and write)
+    seen = {e["tls_subject"]: (e["role"], e["access"]) for e in tls_server.events.seen + tls_server.events.new()
+            if e["event"] == "client_connected" and "tls_subject" in e}
+    assert seen["operator-1"] == ("Operator", "read/write") and seen["viewer-1"] == ("Viewer", "read")
+    assert seen["janitor-1"] == ("Janitor", "read") and seen["plc-1"] == (None, "read/write")
+
+
+def test_read_only_overrides_every_role(pki):
+    with ServerProcess(RING_BENCH, "--lockstep", "--read-only", "--tls-cert", str(pki["server"]), "--tls-key",
+                       str(pki["server_key"]), "--tls-ca", str(pki["ca"]), "--tls-port", "0", "--tls-only") as s:
+        assert tls_request(pki, s.tls_port, "operator", pdu(6, 16, 33000)) == b"\x86\x01"
+        assert tls_request(pki, s.tls_port, "operator", pdu(3, 16, 1))[:2] == b"\x03\x02"

@@ -24,7 +24,18 @@ def _write(folder: Path, stem: str, cert: x509.Certificate, key) -> tuple[Path, 
     return c, k
 
 
-def _cert(subject: str, key, issuer_name: x509.Name, issuer_key, *, ca: bool = False, server: bool = False):
+ROLE_OID = x509.ObjectIdentifier("1.3.6.1.4.1.50316.802.1")  # Modbus/TCP Security: the role extension
+
+
+def _utf8string(text: str) -> bytes:
+    """ASN.1 DER of a UTF8String (tag 12), written out here from X.690, not by the code under test."""
+    data = text.encode("utf-8")
+    assert len(data) < 128  # the short form of the length
+    return bytes((0x0C, len(data))) + data
+
+
+def _cert(subject: str, key, issuer_name: x509.Name, issuer_key, *, ca: bool = False, server: bool = False,
+          role: str | None = None):
     now = datetime.datetime.now(datetime.timezone.utc)
     b = (x509.CertificateBuilder().subject_name(_name(subject)).issuer_name(issuer_name)
          .public_key(key.public_key()).serial_number(x509.random_serial_number())
@@ -36,11 +47,14 @@ def _cert(subject: str, key, issuer_name: x509.Name, issuer_key, *, ca: bool = F
         b = b.add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH]), critical=False)
     elif not ca:
         b = b.add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.CLIENT_AUTH]), critical=False)
+    if role is not None:
+        b = b.add_extension(x509.UnrecognizedExtension(ROLE_OID, _utf8string(role)), critical=False)
     return b.sign(issuer_key, hashes.SHA256())
 
 
 def make_pki(folder: Path) -> dict[str, Path]:
-    keys = {n: ec.generate_private_key(ec.SECP256R1()) for n in ("ca", "server", "client", "stranger_ca", "stranger")}
+    keys = {n: ec.generate_private_key(ec.SECP256R1()) for n in ("ca", "server", "client", "stranger_ca", "stranger",
+                                                                    "operator", "viewer", "janitor")}
     ca = _cert("twin test CA", keys["ca"], _name("twin test CA"), keys["ca"], ca=True)
     sca = _cert("stranger CA", keys["stranger_ca"], _name("stranger CA"), keys["stranger_ca"], ca=True)
     out = {"ca": _write(folder, "ca", ca, keys["ca"])[0]}
@@ -50,4 +64,7 @@ def make_pki(folder: Path) -> dict[str, Path]:
                                               keys["client"])
     out["stranger"], out["stranger_key"] = _write(folder, "stranger", _cert("mallory", keys["stranger"], sca.subject,
                                                                             keys["stranger_ca"]), keys["stranger"])
+    for who, role in (("operator", "Operator"), ("viewer", "Viewer"), ("janitor", "Janitor")):  # role certificates
+        out[who], out[f"{who}_key"] = _write(folder, who, _cert(f"{who}-1", keys[who], ca.subject, keys["ca"], role=role),
+                                             keys[who])
     return out

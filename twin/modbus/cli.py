@@ -184,6 +184,12 @@ def tls_from_args(args):
 
     from .server import tls_context
 
+    try:
+        import cryptography  # noqa: F401  (the client certificates' roles are read with it: twin.modbus.roles)
+    except ImportError:
+        _log("error: Modbus/TCP Security reads each client certificate's role and needs cryptography: "
+             "pip install 'gripper-twin[tls]'", logging.ERROR)
+        return 2
     for k, v in given.items():
         if not Path(v).is_file():
             _log(f"error: --{k.replace('_', '-')} {v}: no such file", logging.ERROR)

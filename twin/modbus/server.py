@@ -79,7 +79,8 @@ from twin.core.defaults import DEFAULT_STEP
 
 from .log import log as _log
 from .pdu import (GATEWAY_TARGET_FAILED, ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION,  # noqa: F401
-                  SERVER_DEVICE_FAILURE, Backend, Deferred, DeviceIdentity, Images, PduHandler, PollHold)
+                  SERVER_DEVICE_FAILURE, WRITE_FUNCTIONS, Backend, Deferred, DeviceIdentity, Images, PduHandler,
+                  PollHold)
 from .protocol import DEFAULT_PORT, MAX_CONNECTIONS, REQUESTS_PER_STEP, TLS_PORT  # noqa: F401
 from .register_map import POLL_HOLD, RegisterMap
 
@@ -228,8 +229,13 @@ class ModbusServer:
         self._sweeper = loop.call_later(min(1.0, self.idle_timeout / 4), self._sweep)
 
     # -- requests -----------------------------------------------------------------------------------
-    def handle(self, unit: int, pdu: bytes, hold: PollHold | None = None) -> bytes:
-        """One request PDU -> its response PDU (`hold`: the connection's poll, see `pdu.PollHold`)."""
+    def handle(self, unit: int, pdu: bytes, hold: PollHold | None = None, read_only: bool = False) -> bytes:
+        """One request PDU -> its response PDU (`hold`: the connection's poll, see `pdu.PollHold`; `read_only`:
+        the connection may only read, its certificate's role says so: a write function gets exception 01)."""
+        if read_only and pdu[:1] and pdu[0] in WRITE_FUNCTIONS:
+            self.pdus.requests += 1
+            self.pdus.refused_writes += 1
+            return bytes((pdu[0] | 0x80, ILLEGAL_FUNCTION))
         if unit not in self.units:
             other = self.route(unit) if self.route is not None else None
             if other is not None:
@@ -307,6 +313,7 @@ class _Connection(asyncio.Protocol):
 
     def __init__(self, server: ModbusServer, tls: bool = False):
         self.server, self.tls = server, tls
+        self.read_only = False  # Modbus/TCP Security: the client certificate's role grants reads only (twin.modbus.roles)
         self.buf = bytearray()
         self.transport: asyncio.Transport | None = None
         self.timer: asyncio.TimerHandle | None = None
@@ -357,11 +364,26 @@ class _Connection(asyncio.Protocol):
         if self.tls:
             cert = transport.get_extra_info("peercert") or {}
             subject = dict(x[0] for x in cert.get("subject", ()) if x)
-            extra = f" over TLS as {subject.get('commonName', '?')!r}"
-            tls = {"tls_subject": subject.get("commonName", "")}
+            access = self._access(transport)
+            self.read_only = access.read_only
+            extra = f" over TLS as {subject.get('commonName', '?')!r} ({access.why})"
+            tls = {"tls_subject": subject.get("commonName", ""), "role": access.role,
+                   "access": "read" if access.read_only else "read/write"}
         server.log(f"client {self.peer} connected{extra} ({len(server.connections)} connected)")
         if server.on_event is not None:
             server.on_event("client_connected", front_end="modbus", peer=self.peer, connected=len(server.connections), **tls)
+
+    def _access(self, transport):
+        """What the client certificate's role grants (`twin.modbus.roles`); a certificate whose role cannot be
+        read is granted reads only."""
+        from .roles import Access, access_for, role_of
+
+        ssl_object = transport.get_extra_info("ssl_object")
+        try:
+            role = role_of(ssl_object.getpeercert(binary_form=True) if ssl_object is not None else None)
+        except Exception as exc:  # noqa: BLE001 - a certificate the TLS layer took but we cannot read: least rights
+            return Access("?", True, f"its role cannot be read ({type(exc).__name__}): read only")
+        return access_for(role, self.server.pdus.read_only)
 
     def connection_lost(self, exc) -> None:
         self.closed = True
@@ -464,7 +486,7 @@ class _Connection(asyncio.Protocol):
             request = bytes(buf[pos + 7:pos + 6 + length])
             if self.clock_only and not clock(request):
                 self.clock_only = False
-            response = handle(unit, request, self.hold)
+            response = handle(unit, request, self.hold, self.read_only)
             pos += 6 + length
             count += 1
             if isinstance(response, Deferred):  # answered once the lockstep steps are done; later ones wait
