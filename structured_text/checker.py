@@ -326,11 +326,7 @@ class Checker:
                 raise self.fail("a function block instance has no initial value here", d.init.span)
         if d.location is not None:
             self.check_location(d, t)
-        if d.section == "VAR_TEMP" and kind == "FUNCTION":
-            pass
         init = self.init_value(t, d.init, scope) if d.init is not None else None
-        if d.constant and d.init is None and t.kind not in ("fb", "program"):
-            init = None
         s = Symbol(d.name, t, d.section, d.span, d.constant, d.retain, d.location, init)
         info.symbols[up] = s
         if d.section in ("VAR_INPUT", "VAR_IN_OUT", "VAR_OUTPUT"):
@@ -671,8 +667,7 @@ class Checker:
                 if t.kind not in ("bool", "bits", "int") or t is ty.LIT_INT and expected is None:
                     raise self.fail(f"NOT needs a BOOL or a bit string, not a {t}", e.span)
                 return t
-            if t.kind not in ("int", "real", "time") or (e.op == "-" and t.kind == "int" and not t.signed
-                                                          and t is not ty.LIT_INT and False):
+            if t.kind not in ("int", "real", "time"):
                 raise self.fail(f"'{e.op}' needs a number, not a {t}", e.span)
             return t
         if isinstance(e, n.Binary):

@@ -318,14 +318,7 @@ class Compiler:
         site = self.site(st.span)
         start = self.expr(st.start)[0]
         end = self.expr(st.end)[0]
-        step_const = None
-        if st.step is None:
-            step_const = 1
-        else:
-            try:
-                step_const = literal_int(st.step)
-            except Exception:
-                step_const = None
+        step_const = 1 if st.step is None else literal_int(st.step)
         r = o.temp("r")
         if step_const is not None:
             if step_const == 0:

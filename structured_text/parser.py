@@ -124,7 +124,7 @@ class Parser:
         while self.tok.kind is Kind.KEYWORD and self.tok.upper in _VAR_SECTIONS + ("VAR_ACCESS", "VAR_CONFIG"):
             self.unsupported_check(self.tok)
             decls.extend(self.var_block())
-        body = self.statements(_POU_END[kind], kw)
+        body = self.statements()
         end = self.closing(_POU_END[kind], kw)
         if self.tok.is_op(";"):  # tolerated: `END_PROGRAM;`
             self.advance()
@@ -378,7 +378,8 @@ class Parser:
         res.programs.append(n.ProgramConf(name.span, name.text, task, task_span, ty.text, ty.span, args, retain))
 
     # ---- statements ------------------------------------------------------------------------------
-    def statements(self, *enders: str, opener: Token | None = None) -> list[n.Stmt]:
+    def statements(self) -> list[n.Stmt]:
+        """Statements up to the END word (or ELSIF, ELSE, UNTIL) of the block around them."""
         out: list[n.Stmt] = []
         while True:
             t = self.tok
@@ -436,7 +437,7 @@ class Parser:
         kw = self.advance()
         branches = []
         cond = self.expression()
-        self.expect_kw("THEN", f" after the IF's condition")
+        self.expect_kw("THEN", " after the IF's condition")
         branches.append((cond, self.statements()))
         orelse = None
         while self.tok.is_kw("ELSIF"):

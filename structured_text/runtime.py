@@ -501,48 +501,48 @@ def coerce(t: ty.DataType, value):
 
 
 def _from_text(t: ty.DataType, value: str):
+    """A literal from the command line as a value of type t (ValueError saying what it needs)."""
+    from .lexer import lex
     k = t.kind
-    if True:
-        from .lexer import lex
-        text = value.strip()
-        up = text.upper()
-        if k == "bool":
-            if up.removeprefix("BOOL#") in ("TRUE", "FALSE", "1", "0"):
-                return up.removeprefix("BOOL#") in ("TRUE", "1")
-            raise ValueError(f"{text!r} is not a BOOL: give TRUE or FALSE")
-        if k == "string":
-            return text[1:-1] if len(text) >= 2 and text[0] == text[-1] == "'" else text
-        if k == "enum":
-            v = t.values.get(up.split("#")[-1])
-            if v is None:
-                raise ValueError(f"{text!r} is not a value of {t.name}")
-            return v[1]
-        try:
-            toks = lex(text, "<value>")
-        except StError as exc:
-            raise ValueError(f"{text!r}: {exc.message}") from None
-        neg = False
-        if len(toks) == 3 and toks[0].is_op("-", "+"):
-            neg = toks[0].text == "-"
-            toks = toks[1:]
-        if len(toks) != 2 or toks[0].value is None:
-            raise ValueError(f"{text!r} is not a value")
-        lit = toks[0].value
-        value = -lit.value if neg else lit.value
-        cat = lit.category
-        if k in ("int", "bits"):
-            if cat != "int":
-                raise ValueError(f"{text!r} is not an integer ({t} needs one)")
-            lo, hi = ty.range_of(t)
-            if not lo <= value <= hi:
-                raise ValueError(f"{text} is out of the range of {t} ({lo}..{hi})")
-            return value
-        if k == "real":
-            if cat not in ("int", "real"):
-                raise ValueError(f"{text!r} is not a number ({t} needs one)")
-            return ty.to_f32(float(value)) if t.bits == 32 else float(value)
-        if k in ("time", "date", "tod", "dt"):
-            if cat != k:
-                raise ValueError(f"{text!r} is not a {t} literal (e.g. T#200ms, D#2024-01-31, TOD#12:00:00)")
-            return value
-        raise ValueError(f"{text!r} cannot be given to a {t}")
+    text = value.strip()
+    up = text.upper()
+    if k == "bool":
+        if up.removeprefix("BOOL#") in ("TRUE", "FALSE", "1", "0"):
+            return up.removeprefix("BOOL#") in ("TRUE", "1")
+        raise ValueError(f"{text!r} is not a BOOL: give TRUE or FALSE")
+    if k == "string":
+        return text[1:-1] if len(text) >= 2 and text[0] == text[-1] == "'" else text
+    if k == "enum":
+        v = t.values.get(up.split("#")[-1])
+        if v is None:
+            raise ValueError(f"{text!r} is not a value of {t.name}")
+        return v[1]
+    try:
+        toks = lex(text, "<value>")
+    except StError as exc:
+        raise ValueError(f"{text!r}: {exc.message}") from None
+    neg = False
+    if len(toks) == 3 and toks[0].is_op("-", "+"):
+        neg = toks[0].text == "-"
+        toks = toks[1:]
+    if len(toks) != 2 or toks[0].value is None:
+        raise ValueError(f"{text!r} is not a value")
+    lit = toks[0].value
+    value = -lit.value if neg else lit.value
+    cat = lit.category
+    if k in ("int", "bits"):
+        if cat != "int":
+            raise ValueError(f"{text!r} is not an integer ({t} needs one)")
+        lo, hi = ty.range_of(t)
+        if not lo <= value <= hi:
+            raise ValueError(f"{text} is out of the range of {t} ({lo}..{hi})")
+        return value
+    if k == "real":
+        if cat not in ("int", "real"):
+            raise ValueError(f"{text!r} is not a number ({t} needs one)")
+        return ty.to_f32(float(value)) if t.bits == 32 else float(value)
+    if k in ("time", "date", "tod", "dt"):
+        if cat != k:
+            raise ValueError(f"{text!r} is not a {t} literal (e.g. T#200ms, D#2024-01-31, TOD#12:00:00)")
+        return value
+    raise ValueError(f"{text!r} cannot be given to a {t}")
