@@ -22,6 +22,14 @@ As pytest fixtures (in your `conftest.py`: `pytest_plugins = ["plc_client.testin
 `plc_server` gives the running server (`.host`, `.port`, `.map`, `.client()`, `.events`: what the server
 says happened, `twin serve --events`, docs/events.md), `plc_lockstep` (default True) chooses lockstep or
 real time. See docs/commissioning-checks.md.
+
+A PLC in Structured Text, in lockstep against the station (`twin serve --layout plc`), its located variables
+bound through the map's device ranges (`plc_client.st_io`):
+
+    def test_press(st_plc):
+        run = st_plc("press.st", program="press")     # program=: the station's declarations come along
+        run.cycle.run_until(lambda inputs, plc: run.get("done"), timeout=10.0)
+        assert run.client.get("axis1.force") >= 200.0
 """
 from __future__ import annotations
 
@@ -189,3 +197,45 @@ if pytest is not None:
         """A TwinClient connected to `plc_server`."""
         with plc_server.client() as client:
             yield client
+
+    @pytest.fixture
+    def st_plc(plc_station, tmp_path):
+        """`st_plc(*files, program=None, cycle=0.010)` -> a `StPlcRun`: the ST PLC of `files` scanning in lockstep
+        against `plc_station` served with the PLC layout (one server per test). With `program`, the station's
+        declarations (`twin map --format st --program PROGRAM`) are added to the files."""
+        with contextlib.ExitStack() as stack:
+            def start(*files, program: str | None = None, cycle: float = 0.010) -> StPlcRun:
+                server = stack.enter_context(twin_server(plc_station, lockstep=True, layout="plc"))
+                files = [Path(f) for f in files]
+                if program is not None:
+                    from twin.modbus.plc_export import to_structured_text
+
+                    io = tmp_path / f"io_{program}.st"
+                    io.write_text(to_structured_text(server.map, program=program), encoding="utf-8")
+                    files.append(io)
+                return stack.enter_context(StPlcRun(server, files, cycle))
+            yield start
+
+
+class StPlcRun:
+    """An ST PLC on a scan cycle against a lockstep server: `.cycle` (the `ScanCycle`: scan, run, run_until),
+    `.client` (a TwinClient: the twin's signals by name), `.get(name)` (a variable of the PLC's program instance),
+    `.plc` (the runtime)."""
+
+    def __init__(self, server: TwinServer, files: list[Path], cycle: float):
+        from .scan import ScanCycle
+        from .st_io import StLogic
+
+        self.server, self.logic = server, StLogic(files, server.map)
+        self.client = server.client()
+        self.cycle = ScanCycle(ClientIO(self.client, lockstep=True), self.logic, cycle=cycle)
+        self.plc = self.cycle.state
+
+    def get(self, name: str):
+        return self.plc.get(f"{self.logic.instance}.{name}")
+
+    def __enter__(self) -> "StPlcRun":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.client.close()

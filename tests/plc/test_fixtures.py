@@ -76,3 +76,36 @@ def test_a_part_taken_away_by_its_coil_makes_the_grip_miss(plc_server, twin_clie
     twin_client.advance(2)
     assert twin_client.read("ring.x", "ring.y", "ring.z") == pytest.approx(
         {"ring.x": 1600.0, "ring.y": -800.0, "ring.z": 180.0}, abs=0.5)
+
+
+PRESS_ST = """PROGRAM press
+  VAR_EXTERNAL
+    L2 : UINT;
+    L2_actual : UINT;
+    L2_force_HI : INT;
+    L2_force_LO : UINT;
+  END_VAR
+  VAR
+    force : DINT;
+    done : BOOL;
+  END_VAR
+  force := INT_TO_DINT(L2_force_HI) * 65536 + UINT_TO_DINT(L2_force_LO);  (* counts of 0.01 N *)
+  IF force >= 20000 THEN
+    done := TRUE;
+  END_IF;
+  IF NOT done THEN
+    L2 := L2_actual - 100;  (* 1 mm inside where it is *)
+  END_IF;
+END_PROGRAM
+"""
+
+
+@pytest.mark.skipif(importlib.util.find_spec("structured_text") is None, reason="the ST runtime has not landed")
+def test_an_st_plc_in_lockstep_against_the_station(st_plc, tmp_path):
+    """The same check as the Python logic above, written in ST with the station's generated declarations."""
+    src = tmp_path / "press.st"
+    src.write_text(PRESS_ST)
+    run = st_plc(src, program="press")
+    run.cycle.run_until(lambda inputs, plc: run.get("done"), timeout=10.0)
+    assert run.client.get("L2.force") >= 200.0  # the twin's measured force
+    assert run.get("force") >= 20000  # and the PLC's, assembled from its two located words
