@@ -152,13 +152,13 @@ class Checker:
                     self.errors.append(self.fail(f"'{p.name}' is the name of a standard function", p.span))
                     continue
                 self.pous[up] = PouInfo(p, p.name, p.kind)
-        for up in list(self.type_decls):
-            self.guard(self.named_type, self.type_decls[up].name, self.type_decls[up].span)
-        for info in self.pous.values():  # FB and program types first: members may be instances of them
+        # the order: FB and program types (a TYPE, a global or a member may be an instance of one), the
+        # TYPEs, the globals (their constants may size a POU's arrays), then the POUs' variables
+        for info in self.pous.values():
             if info.kind != "FUNCTION":
                 info.fbtype = (ty.ProgramT if info.kind == "PROGRAM" else ty.FbT)(info.name, pou=info)
-        for info in self.pous.values():
-            self.declare_pou(info)
+        for up in list(self.type_decls):
+            self.guard(self.named_type, self.type_decls[up].name, self.type_decls[up].span)
         configs = [c for f in self.files for c in f.configurations]
         for f in self.files:
             for d in f.globals:
@@ -169,6 +169,8 @@ class Checker:
             for r in c.resources:
                 for d in r.globals:
                     self.guard(self.declare_global, d)
+        for info in self.pous.values():
+            self.declare_pou(info)
         for info in self.pous.values():
             self.resolve_externals(info)
         for info in self.pous.values():
@@ -308,6 +310,7 @@ class Checker:
             t = self.type_of(d.spec, scope)
             s = Symbol(d.name, t, d.section, d.span, d.constant)
             info.symbols[up] = s
+            s.target = self.globals.get(up)  # checked by resolve_externals; linked now for constant bounds
             return
         try:
             t = self.type_of(d.spec, scope)
@@ -364,6 +367,7 @@ class Checker:
         for s in list(info.symbols.values()):
             if s.section != "VAR_EXTERNAL":
                 continue
+            s.target = None
             g = self.globals.get(s.name.upper())
             if g is None:
                 self.errors.append(self.fail(f"VAR_EXTERNAL '{s.name}' names no VAR_GLOBAL", s.span))
@@ -486,6 +490,10 @@ class Checker:
                 if e is not None:
                     et = self.expr(e, scope, vt)
                     self.need_assignable(vt, et, e, "the FOR loop's bound")
+                    try:  # a constant bound lets the compiler drop index checks the loop cannot fail
+                        e.const = self.const_int(e, scope)
+                    except CheckError:
+                        e.const = None
             scope.loops += 1
             scope.for_vars.append(st.var.ref)
             self.stmts(st.body, scope)

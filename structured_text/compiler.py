@@ -318,7 +318,7 @@ class Compiler:
         site = self.site(st.span)
         start = self.expr(st.start)[0]
         end = self.expr(st.end)[0]
-        step_const = 1 if st.step is None else literal_int(st.step)
+        step_const = 1 if st.step is None else getattr(st.step, "const", None)
         r = o.temp("r")
         if step_const is not None:
             if step_const == 0:
@@ -339,8 +339,10 @@ class Compiler:
         o.level += 1
         o.emit(f"{target} = {var}")
         self.budget(site)
-        lo, hi = literal_int(st.start), literal_int(st.end)
-        if lo is not None and hi is not None and step_const is not None and step_const < 0:
+        lo, hi = getattr(st.start, "const", None), getattr(st.end, "const", None)
+        if lo is None or hi is None or step_const is None:
+            lo = hi = None
+        elif step_const < 0:
             lo, hi = hi, lo
         sym = st.var.ref
         self.loop_vars[id(sym)] = (var, lo, hi)  # the body reads the control variable from the Python local

@@ -279,3 +279,31 @@ END_PROGRAM
     plc.set("go", True)
     plc.scan_ns(10 * MS)
     assert (plc.get("c.CV"), plc.get("ok"), plc.get("a")) == (1, True, 11)
+
+
+def test_global_constants_size_arrays_and_structs_hold_block_instances(tmp_path):
+    plc = plc_of(tmp_path, """
+TYPE Pair : STRUCT a : Acc; n : INT; END_STRUCT; END_TYPE
+FUNCTION_BLOCK Acc
+VAR_INPUT x : INT; END_VAR
+VAR_OUTPUT s : INT; END_VAR
+s := s + x;
+END_FUNCTION_BLOCK
+PROGRAM main
+VAR_EXTERNAL CONSTANT N : INT; END_VAR
+VAR arr : ARRAY[1..N] OF INT; p : Pair; k : INT; END_VAR
+FOR k := 1 TO N DO arr[k] := k * k; END_FOR;
+p.a(x := 2);
+p.n := arr[N];
+END_PROGRAM
+CONFIGURATION c
+VAR_GLOBAL CONSTANT N : INT := 4; END_VAR
+RESOURCE r ON PLC
+  TASK t (INTERVAL := T#10ms, PRIORITY := 1);
+  PROGRAM m WITH t : main;
+END_RESOURCE
+END_CONFIGURATION
+""")
+    plc.scan_ns(0)
+    plc.scan_ns(10 * MS)
+    assert (plc.get("m.p.n"), plc.get("m.p.a.s"), plc.get("m.arr[4]"), plc.get("m.k")) == (16, 4, 16, 5)
