@@ -77,3 +77,27 @@ def test_the_st_gripper_plc_grips_the_ring_over_modbus_in_lockstep():
     changes = [line for line in out.stdout.splitlines() if line.startswith("t=")]
     assert any("diGripOk=1" in line for line in changes), changes
     assert not any("diGripFault=1" in line for line in changes), changes
+
+
+WIDE = """PROGRAM wide
+  VAR_EXTERNAL
+    L5 : UINT;
+  END_VAR
+  L5 := 5000;  (* 50 mm: the fine axis travels 0 .. 10 mm *)
+END_PROGRAM
+"""
+
+
+def test_an_st_plc_whose_write_the_twin_refuses_stops_naming_the_signal_the_value_and_why(tmp_path):
+    sys.path.insert(0, str(ROOT / "tests" / "modbus"))
+    from modbus_helpers import ServerProcess
+
+    bench = ROOT / "tests" / "plc" / "stations" / "ring_bench"
+    (tmp_path / "wide.st").write_text(WIDE)
+    (tmp_path / "io.st").write_text(subprocess.run([sys.executable, "-m", "twin", "map", str(bench), "--format", "st",
+                                                    "--program", "wide"], cwd=ROOT, capture_output=True, text=True,
+                                                   check=True).stdout)
+    with ServerProcess(bench, "--lockstep", "--layout", "plc") as server:
+        out = plc("run", str(tmp_path / "wide.st"), str(tmp_path / "io.st"), "--port", str(server.port), "--for", "1")
+    assert out.returncode == 1
+    assert re.search(r"L5=50 refused at scan 0 .*'L5': 50 mm is out of range: 0 to 10 mm; the PLC stopped", out.stderr)
