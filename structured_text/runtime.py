@@ -95,6 +95,7 @@ class Plc:
         self.budget = self.ns["_rt"]
         self.fault: PlcFault | None = None
         self.scans = 0
+        self._slots: dict = {}
         self.trace_hooks: list[Callable[["Plc", float], None]] = []
         self.cold_restart()
 
@@ -267,20 +268,23 @@ class Plc:
                     out.append((text(s.location), s.name if single else f"{inst.name}.{s.name}", s.type.name))
         return out
 
+    def _slot(self, address: str):
+        """(image, key, mask) of an address, parsed once (a fieldbus binding calls this every scan)."""
+        slot = self._slots.get(address)
+        if slot is None:
+            area, size, idx = parse_address(address)
+            image = {"I": self.inputs, "Q": self.outputs, "M": self.memory}[area]
+            mask = None if size == "X" else (1 << {"B": 8, "W": 16, "D": 32, "L": 64}[size]) - 1
+            slot = self._slots[address] = (image, (size, idx), mask)
+        return slot
+
     def read_located(self, address: str):
-        area, size, idx = parse_address(address)
-        image = {"I": self.inputs, "Q": self.outputs, "M": self.memory}[area]
-        return image.get((size, idx), False if size == "X" else 0)
+        image, key, mask = self._slot(address)
+        return image.get(key, False if mask is None else 0)
 
     def write_located(self, address: str, value) -> None:
-        area, size, idx = parse_address(address)
-        image = {"I": self.inputs, "Q": self.outputs, "M": self.memory}[area]
-        if size == "X":
-            value = bool(value)
-        else:
-            bits = {"B": 8, "W": 16, "D": 32, "L": 64}[size]
-            value = int(value) & ((1 << bits) - 1)
-        image[(size, idx)] = value
+        image, key, mask = self._slot(address)
+        image[key] = bool(value) if mask is None else int(value) & mask
 
     # ---- variables by name -----------------------------------------------------------------------
     def resolve(self, name: str) -> "VarRef | LocatedRef":
