@@ -183,7 +183,7 @@ def test_program(path: Path):
         assert err.strip() == "", err
 
 
-def test_shlex_args_of_every_file_parse():
+def test_every_file_states_an_expectation():
     """The corpus itself is well formed: every file has a run or a check with an expectation."""
     for path in FILES:
         exp = expectations(path)
