@@ -81,16 +81,21 @@ class LocatedBinding:
         self.outputs = [v for v in self.variables if v.address.startswith("%Q")]
         self.output_entries = list(dict.fromkeys(v.entry for v in self.outputs))
         self.input_entries = list(dict.fromkeys(v.entry for v in self.inputs))
+        # per entry, its words: (address, which word, a bit?), in the order of the entry's words
+        self._words_in = {e.name: [(v.address, 1 if v.word == "LO" else 0, e.type == "bool")
+                                   for v in self.inputs if v.entry is e] for e in self.input_entries}
+        self._words_out = {e.name: [(v.address, 1 if v.word == "LO" else 0) for v in self.outputs if v.entry is e]
+                           for e in self.output_entries}
 
     def input_image(self, values: Mapping[str, Any]) -> dict[str, int | bool]:
         """Address -> word (or bit) from signal values in engineering units, by entry name."""
         image = {}
-        for v in self.inputs:
-            if v.entry.name not in values:
+        for e in self.input_entries:
+            if e.name not in values:
                 continue
-            words = v.entry.encode(values[v.entry.name], engineering=True)
-            word = words[1] if v.word == "LO" else words[0]
-            image[v.address] = bool(word) if v.entry.type == "bool" else int(word)
+            words = e.encode(values[e.name], engineering=True)
+            for address, k, bit in self._words_in[e.name]:
+                image[address] = bool(words[k]) if bit else int(words[k])
         return image
 
     def output_values(self, image: Mapping[str, int | bool]) -> dict[str, Any]:
@@ -121,6 +126,12 @@ class StLogic:
         self.binding = LocatedBinding(rmap)
         self.inputs = tuple(e.name for e in self.binding.input_entries)
         self.outputs = tuple(e.name for e in self.binding.output_entries)
+        from weakref import WeakKeyDictionary
+
+        from structured_text.runtime import parse_address
+
+        self._keys = {v.address: parse_address(v.address)[1:] for v in self.binding.variables}  # the runtime's
+        self._last: WeakKeyDictionary = WeakKeyDictionary()  # per PLC: the input values last written
         self.settings = dict(settings or {})
         self.instance = self.compiled.program.instances[0].name if self.compiled.program.instances else ""
         probe = Plc(self.compiled)
@@ -157,8 +168,24 @@ class StLogic:
                                fault=Fault(int(plc.get(f"{self.instance}.fault_code"))))
 
     def __call__(self, inputs: Mapping, plc) -> dict:
-        values = {n: inputs[n] for n in self.inputs if n in inputs}
-        for address, word in self.binding.input_image(values).items():
-            plc.write_located(address, word)
+        """One scan. The input image is written straight into the runtime's (`Plc.inputs`, keyed as its
+        `parse_address` keys an address), only for the values that changed since the last scan."""
+        last = self._last.get(plc)
+        if last is None or not plc.inputs:  # a new PLC, or one restarted cold (its input image cleared)
+            last = self._last[plc] = {}
+        keys = self._keys
+        image, words_in = plc.inputs, self.binding._words_in
+        for e in self.binding.input_entries:
+            name = e.name
+            if name not in inputs:
+                continue
+            value = inputs[name]
+            if name in last and last[name] == value and type(last[name]) is type(value):
+                continue
+            last[name] = value
+            words = e.encode(value, engineering=True)
+            for address, k, bit in words_in[name]:
+                image[keys[address]] = bool(words[k]) if bit else int(words[k]) & 0xFFFF
         plc.scan(float(getattr(inputs, "time", 0.0)))
-        return self.binding.output_values({v.address: plc.read_located(v.address) for v in self.binding.outputs})
+        out = plc.outputs
+        return self.binding.output_values({v.address: out.get(keys[v.address], 0) for v in self.binding.outputs})
