@@ -112,6 +112,41 @@ def options_from(args) -> dict | None:
             "watchdog": getattr(args, "watchdog", None)}
 
 
+class OneLineLog(logging.Handler):
+    """asyncua's log (and the OPC UA front end's) in the server's log, one line per record, no traceback:
+    a client that sends what is not OPC UA costs one line naming what asyncua could not read, not a stack."""
+
+    # said again, with the error, by the record that follows
+    NOISE = ("Received an error message type", "Unsupported message type")
+    SAID = {"Exception raised while processing message from client": "a client's message could not be processed "
+                                                                      "(its connection is closed)"}
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            text = record.getMessage()
+        except Exception:  # noqa: BLE001 - a bad format argument must not reach asyncua
+            text = str(record.msg)
+        if text.startswith(self.NOISE):
+            return
+        text = self.SAID.get(text, text)
+        exc = record.exc_info[1] if record.exc_info else None
+        if exc is not None:
+            why = str(exc).splitlines()[0] if str(exc) else ""
+            text = f"{text}: {type(exc).__name__}" + (f": {why}" if why else "")
+        logging.getLogger("twin.serve").log(min(record.levelno, logging.WARNING), f"OPC UA: {text}")
+
+
+def route_opcua_log() -> None:
+    """Send the loggers of asyncua and of this front end through `OneLineLog` (once)."""
+    for name in ("asyncua.server", "asyncua.common", "asyncua.crypto", "twin.opcua"):  # not a client's (asyncua.client)
+        lg = logging.getLogger(name)
+        if not any(isinstance(h, OneLineLog) for h in lg.handlers):
+            lg.addHandler(OneLineLog())
+        lg.propagate = False
+        if lg.level == logging.NOTSET:
+            lg.setLevel(logging.WARNING)
+
+
 class OpcUaFrontEnd:
     """OPC UA as a front end of a cell (the contract: `twin_app.cell`): `OpcUaFrontEnd.from_args(args)`."""
 
@@ -140,6 +175,7 @@ class OpcUaFrontEnd:
 
         from .cell_link import CellLink, ServerThread
 
+        route_opcua_log()
         watchdog = getattr(cell, "watchdog", None)
         if watchdog is not None:
             if self.watchdog is not None:
