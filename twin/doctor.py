@@ -343,7 +343,7 @@ class Doctor:
         self.report = Report(twin.station.name, str(twin.station.file), hold)
         self.want_picture = picture
         self.pictures: list = []
-        self._gripped_at = None  # the part in the base link's frame when doGripped rose
+        self._gripped_at = None  # the part relative to the gripper when doGripped rose
         self.carrier = twin.world.link_index[twin.mechanism.base_link]  # the palm: see `relative`
         self.lift_axis: tuple[str, float] | None = None  # without a robot: an axis that lifts every finger alike
         self.log = log or (lambda text: None)
@@ -362,14 +362,6 @@ class Doctor:
 
     def steps(self, seconds: float) -> int:
         return max(1, round(seconds / self.twin.dt))
-
-    def base_pose(self) -> Pose:
-        j = self.twin.world.link_index[self.mech.base_link]
-        if j < 0:
-            p, o = self.c.getBasePositionAndOrientation(self.body)
-        else:
-            p, o = self.c.getLinkState(self.body, j, computeForwardKinematics=True)[:2]
-        return Pose(p, o)
 
     def part_pose(self, name: str) -> Pose:
         return Pose(*self.twin.object_pose(name))
@@ -641,7 +633,7 @@ class Doctor:
                     res[f].onset_position = self.c.getJointState(self.body, joints[f])[0]
             if result.gripped_step is None and tw.read("GrippedPart") == name:
                 result.gripped_step = k
-                self._gripped_at = self.in_base(name)
+                self._gripped_at = self.relative(name)
             if all(r.onset_step is not None for r in res.values()) or k >= limit:
                 break
         for _ in range(STALL_STEPS):  # the steps a touching finger has to settle in: their status counts
@@ -662,7 +654,7 @@ class Doctor:
             tw.step()
             if result.gripped_step is None and tw.read("GrippedPart") == name:
                 result.gripped_step = tw.step_count - t0
-                self._gripped_at = self.in_base(name)
+                self._gripped_at = self.relative(name)
             for f in fingers:
                 status[f].append(int(tw.read(f"{f}.status")))
                 pos[f].append(self.c.getJointState(self.body, joints[f])[0])
@@ -770,16 +762,12 @@ class Doctor:
         if result.gripped_step is None:
             self.check(WARN, where, "grip", "doGripped", "never reported the part gripped")
 
-    def in_base(self, name: str):
-        """The part's position in the gripper's base link frame (what `slip` is measured against)."""
-        return (self.base_pose().inverse() * self.part_pose(name)).position
-
     def judge_slip(self, name: str, where: str, when: str) -> None:
-        """`slip` must say whether the part moved more than slip_distance relative to the base link since the
-        grip (docs/station-format.md): a WARN when it says otherwise (1 mm either side is left to the physics)."""
+        """`slip` must say whether the part moved more than slip_distance relative to the gripper since the grip
+        (docs/station-format.md): a WARN when it says otherwise (1 mm either side is left to the physics)."""
         if self._gripped_at is None:
             return
-        moved = float(sum((self.in_base(name) - self._gripped_at) ** 2) ** 0.5)
+        moved = float(sum((self.relative(name) - self._gripped_at) ** 2) ** 0.5)
         raised, limit = bool(self.twin.read("slip")), self.g.spec.slip_distance
         if raised and moved < limit - 1e-3:
             self.check(WARN, where, "grip", "slip", f"raised at the end of {when}, the part {_fmt_len(moved)} from "
