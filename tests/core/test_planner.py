@@ -70,3 +70,17 @@ def test_zones_blend_on_this_arm_within_the_zone_and_without_stopping(twin):
         assert v[d < 0.035].min() > 0.1  # through the corner at speed
         assert 0.002 < d.min() < 0.03 / math.sqrt(2)  # cut, inside the chord of the zone
     assert np.linalg.norm(p[-1] - corners[2]) < 0.0005
+
+
+def test_blended_motions_replay_bit_for_bit(tmp_path):
+    runs = []
+    for k in range(2):
+        (tmp_path / str(k)).mkdir()
+        with Twin.from_station(robot_station(tmp_path / str(k), ARM)) as twin:
+            z = Zone(False, 0.05, 0.075, 0.075, math.radians(7.5))
+            twin.move("MoveJ", down(1.5, -0.3, 0.7), Speed(v_tcp=1.0), zone=z)
+            twin.move("MoveL", down(1.8, -0.3, 0.7), Speed(v_tcp=0.5), zone=z)
+            twin.move("MoveL", down(1.8, 0.2, 0.7), Speed(v_tcp=0.5), zone=FINE)
+            run(twin)
+            runs.append(np.concatenate([twin.robot.q, twin.robot.qd, [twin.time]]))
+    assert np.array_equal(runs[0], runs[1])
