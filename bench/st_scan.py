@@ -2,113 +2,125 @@
 
     python -m bench st [--scans N] [--statements N] [--repeat R]
 
-1. A grip sequence: the ring rig's Python PLC (`CarefulGripSequence`, the careful watch included) and a
-   grip sequence in ST of the same size (bench/st/grip_sequence.st: three fingers, ramps, press, miss,
-   release margin, prepare, finger watch, timeout, lost part), on the same input images: a grip, a hold, a
-   release and a prepare move recorded from the Python PLC driving a small finger model (fingers that follow
-   their setpoints at a bounded speed; a ring at 320 mm that pushes back at 2500 N/mm). Each scan of the ST
-   PLC includes copying the image into its located inputs and its outputs back, as its scan does.
-2. A 2000-statement program (assignments, IFs, arithmetic on INT, REAL and BOOL, a timer): the cost per scan and
-   per statement.
-Target (issue 19): the ST grip sequence's scan within 2x of the Python PLC's.
+1. The ring rig's gripper PLC: the Python `CarefulGripSequence` (`plc_logic.cell_sequence`) and the same
+   sequence in ST (`stations/ring_rig_plc/gripper.st` with its generated `io.st`), on the same input images:
+   grips, holds and releases recorded from the Python PLC driving a small finger model (fingers that follow
+   their setpoints at a bounded speed; a ring at 320 mm that pushes back). The ST row is the PLC's scan
+   (input image into its located variables, the task, the outputs into the output image: the input images are
+   encoded to register words beforehand); a second row adds
+   the Modbus-layout binding (`plc_client.st_io.StLogic`: signal values in engineering units to register
+   words and back), which a real PLC's fieldbus does in hardware. Both PLCs must go through the same phases.
+2. A 2000-statement program (assignments, IFs, arithmetic on INT, DINT, REAL and BOOL, a timer): the cost
+   per scan and per statement, and the time to check and compile it.
+Target (issue 19): the gripper PLC's scan in ST within 2x of the Python PLC's.
 """
 from __future__ import annotations
 
 import argparse
-import statistics
 import tempfile
 import time
 from pathlib import Path
 
-HERE = Path(__file__).parent
-GRIP_ST = HERE / "st" / "grip_sequence.st"
 CYCLE = 0.010
 
 
-def record_images(scans: int) -> list[tuple[float, dict]]:
-    """The input images of `scans` scans of the Python grip sequence driving a small finger model."""
-    from plc_client.scan import InputImage
+def _rig():
     from stations.ring_rig_plc import plc_logic as rig
+    return rig
 
-    seq = rig.sequence()
+
+def st_logic():
+    from plc_client.st_io import StLogic
+    from stations.ring_rig_plc.demo import DEFAULT_STATION, ST_FILES
+    from twin.modbus.register_map import build_map
+
+    return StLogic([DEFAULT_STATION / f for f in ST_FILES], build_map(DEFAULT_STATION, "plc"))
+
+
+def record_images(scans: int) -> list[tuple[float, dict]]:
+    """The input images of `scans` scans of the Python gripper PLC driving a small finger model: a grip
+    request at 0.1 s of every 6 s, a release request at 3 s."""
+    from plc_client.scan import InputImage
+
+    rig = _rig()
+    seq = rig.cell_sequence()
     state = seq.initial_state()
     h = seq.handshake
-    pos = {a: 330.0 for a in rig.AXES}
+    pos = {a: 350.0 for a in rig.AXES}
     setp = dict(pos)
-    requests = {h.grip_request: False, h.release_request: False, h.inside: False}
     images = []
     for k in range(scans):
         t = k * CYCLE
-        phase_t = t % 6.0
-        requests[h.grip_request] = 0.1 <= phase_t < 2.5
-        requests[h.release_request] = 3.0 <= phase_t < 5.5
-        values = dict(requests)
-        values["link.ok"] = True
+        cyc = t % 6.0
+        values = {h.grip_request: 0.1 <= cyc < 2.5, h.release_request: 3.0 <= cyc < 5.5, h.inside: False,
+                  h.prepare_request: False, h.prepare_position: 0.0, "sim.time_ms": round(t * 1000.0)}
         for a, f, c, e in zip(rig.AXES, rig.FORCES, rig.CONTACTS, rig.EFFORTS):
             squeeze = max(0.0, 320.0 - pos[a])
-            force = 2500.0 * squeeze
-            values[f"{a}.actual"] = pos[a]
-            values[f] = force
-            values[c] = squeeze > 0.0
-            values[e] = force
+            force = min(4000.0, 2500.0 * squeeze)
+            values.update({f"{a}.actual": pos[a], f: force, c: squeeze > 0.0, e: force})
         images.append((t, values))
         out = seq(InputImage(values, t, CYCLE, k), state)
         for a in rig.AXES:
             if a in out:
                 setp[a] = float(out[a])
-            goal = max(setp[a], 320.0 - 4000.0 / 2500.0)  # the ring stops the finger (a stiff servo on it)
-            step = 60.0 * CYCLE
+            goal = max(setp[a], 320.0 - 4000.0 / 2500.0)  # the ring stops the finger
+            step = 150.0 * CYCLE
             pos[a] = goal if abs(goal - pos[a]) <= step else pos[a] + (step if goal > pos[a] else -step)
     return images
 
 
-def st_images(images: list[tuple[float, dict]]) -> list[tuple[int, dict]]:
-    """The same images as the ST PLC's located inputs (OpenPLC: %IX100.x bits, %IW100.. words; 0.1 mm, N)."""
-    from stations.ring_rig_plc import plc_logic as rig
-
-    out = []
-    for t, v in images:
-        img = {("X", (100, 0)): v["grip_request"], ("X", (100, 1)): v["release_request"],
-               ("X", (100, 2)): v["grip_inside"], ("X", (100, 3)): False, ("X", (100, 7)): v["link.ok"],
-               ("W", (109,)): 3300}
-        for i, (a, f, c, e) in enumerate(zip(rig.AXES, rig.FORCES, rig.CONTACTS, rig.EFFORTS)):
-            img[("X", (100, 4 + i))] = v[c]
-            img[("W", (100 + i,))] = round(v[f"{a}.actual"] * 10.0)
-            img[("W", (103 + i,))] = min(32767, round(v[f]))
-            img[("W", (106 + i,))] = min(32767, round(v[e]))
-        out.append((round(t * 1e9), img))
-    return out
-
-
-def time_python(images, repeat: int) -> float:
+def time_python(images, repeat: int) -> tuple[float, list]:
     from plc_client.scan import InputImage
-    from stations.ring_rig_plc import plc_logic as rig
 
-    best = float("inf")
+    best, phases = float("inf"), []
     for _ in range(repeat):
-        seq = rig.sequence()
+        seq = _rig().cell_sequence()
         state = seq.initial_state()
         frames = [InputImage(v, t, CYCLE, k) for k, (t, v) in enumerate(images)]
         t0 = time.perf_counter()
         for frame in frames:
             seq(frame, state)
         best = min(best, (time.perf_counter() - t0) / len(frames))
-    return best
+    seq = _rig().cell_sequence()
+    state = seq.initial_state()
+    for k, (t, v) in enumerate(images):
+        seq(InputImage(v, t, CYCLE, k), state)
+        phases.append(int(state.phase))
+    return best, phases
 
 
-def time_st(paths, images, repeat: int) -> float:
-    from structured_text.runtime import load
+def time_st(images, repeat: int) -> tuple[float, float, list]:
+    """(scan only, scan with the binding, the phases): the PLC's input images are encoded beforehand for the first."""
+    from plc_client.scan import InputImage
 
-    best = float("inf")
+    logic = st_logic()
+    probe = logic.initial_state()
+    encoded = []
+    for t, v in images:
+        words = logic.binding.input_image({n: v[n] for n in logic.inputs if n in v})
+        encoded.append((round(t * 1e9), {probe._slot(a)[1]: w for a, w in words.items()}))
+    scan_only = bound = float("inf")
     for _ in range(repeat):
-        plc = load(paths)
+        plc = logic.initial_state()
         inputs = plc.inputs
         t0 = time.perf_counter()
-        for now, img in images:
+        for now, img in encoded:
             inputs.update(img)
             plc.scan_ns(now)
-        best = min(best, (time.perf_counter() - t0) / len(images))
-    return best
+        scan_only = min(scan_only, (time.perf_counter() - t0) / len(encoded))
+        plc = logic.initial_state()
+        frames = [InputImage(v, t, CYCLE, k) for k, (t, v) in enumerate(images)]
+        t0 = time.perf_counter()
+        for frame in frames:
+            logic(frame, plc)
+        bound = min(bound, (time.perf_counter() - t0) / len(frames))
+    plc = logic.initial_state()
+    phases = []
+    for now, img in encoded:
+        plc.inputs.update(img)
+        plc.scan_ns(now)
+        phases.append(int(plc.get(f"{logic.instance}.phase")))
+    return scan_only, bound, phases
 
 
 def big_program(statements: int) -> str:
@@ -136,28 +148,45 @@ def big_program(statements: int) -> str:
     return "\n".join(decl + body + ["END_PROGRAM", ""])
 
 
+def time_big(statements: int, repeat: int) -> tuple[float, float]:
+    from structured_text.runtime import load
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "big.st"
+        path.write_text(big_program(statements))
+        t0 = time.perf_counter()
+        load([path])
+        build = time.perf_counter() - t0
+        best = float("inf")
+        for _ in range(repeat):
+            plc = load([path])
+            t0 = time.perf_counter()
+            for k in range(200):
+                plc.scan_ns(round(k * CYCLE * 1e9))
+            best = min(best, (time.perf_counter() - t0) / 200)
+    return best, build
+
+
 def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench st", description=__doc__.splitlines()[0])
-    ap.add_argument("--scans", type=int, default=1200, help="scans of the grip sequence (default 1200: two cycles)")
+    ap.add_argument("--scans", type=int, default=1200, help="scans of the gripper PLC (default 1200: two grip cycles)")
     ap.add_argument("--statements", type=int, default=2000, help="statements of the big program (default 2000)")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each, the best counts (default 3)")
     args = ap.parse_args(argv)
     images = record_images(args.scans)
-    py = time_python(images, args.repeat)
-    st = time_st([GRIP_ST], st_images(images), args.repeat)
-    lines = sum(1 for _ in GRIP_ST.open())
-    print(f"grip sequence, {args.scans} scans on the same input images")
-    print(f"  {'Python PLC (CarefulGripSequence)':<40} {py * 1e6:9.1f} us/scan")
-    print(f"  {f'Structured Text ({lines} lines, compiled)':<40} {st * 1e6:9.1f} us/scan")
-    print(f"  ST / Python: {st / py:.2f}  (target: within 2x)")
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "big.st"
-        path.write_text(big_program(args.statements))
-        t0 = time.perf_counter()
-        from structured_text.runtime import load
-        load([path])
-        build = time.perf_counter() - t0
-        big = time_st([path], [(round(k * CYCLE * 1e9), {}) for k in range(200)], args.repeat)
-    print(f"{args.statements}-statement program: {big * 1e6:9.1f} us/scan, {big * 1e9 / args.statements:6.0f} ns/statement"
-          f"; check + compile {build * 1e3:.0f} ms")
+    py, py_phases = time_python(images, args.repeat)
+    st, bound, st_phases = time_st(images, args.repeat)
+    def steps(phases):  # the sequence of phases, each once
+        return [p for k, p in enumerate(phases) if k == 0 or phases[k - 1] != p]
+    apart = sum(a != b for a, b in zip(py_phases, st_phases))
+    same = (f"the same phases, {apart} scans apart: the ST PLC reads 0.1 mm register words" if
+            steps(py_phases) == steps(st_phases) else "THE PHASES DIFFER")
+    print(f"the ring rig's gripper PLC, {args.scans} scans on the same input images ({same})")
+    print(f"  {'Python PLC (CarefulGripSequence)':<44} {py * 1e6:9.1f} us/scan")
+    print(f"  {'Structured Text (gripper.st), the scan':<44} {st * 1e6:9.1f} us/scan   ST / Python: {st / py:.2f}"
+          "  (target: within 2x)")
+    print(f"  {'  + the Modbus-layout binding (StLogic)':<44} {bound * 1e6:9.1f} us/scan")
+    big, build = time_big(args.statements, args.repeat)
+    print(f"{args.statements}-statement program: {big * 1e6:9.1f} us/scan, {big * 1e9 / args.statements:6.0f} "
+          f"ns/statement; check + compile {build * 1e3:.0f} ms")
     return 0

@@ -374,7 +374,7 @@ class Compiler:
 
     def lvalue_code(self, e: n.Expr) -> str:
         if isinstance(e, n.Direct):
-            return f"_{e.area}[{(e.size, e.index)!r}]"
+            return f"_{e.area}[{direct_key(e)!r}]"
         return self.expr(e)[0]
 
     def store(self, tt: ty.DataType, code: str, vt: ty.DataType, fits: bool, span) -> str:
@@ -531,7 +531,7 @@ class Compiler:
             return f"((({base}) >> {e.bit}) & 1 != 0)", True
         if isinstance(e, n.Direct):
             default = "False" if e.size == "X" else "0"
-            return f"_{e.area}.get({(e.size, e.index)!r}, {default})", True
+            return f"_{e.area}.get({direct_key(e)!r}, {default})", True
         if isinstance(e, n.Unary):
             code, fits = self.expr(e.operand)
             t = e.ty
@@ -665,3 +665,8 @@ class Compiler:
                 return f32(code), True
             return code, _FITS_STD.get(up, False)
         raise CheckError("a function block call is a statement", c.span)
+
+
+def direct_key(e: n.Direct) -> str:
+    """The images' key of a direct address (as runtime.address_key: its canonical text)."""
+    return f"%{e.area}{e.size}{'.'.join(str(i) for i in e.index)}"
