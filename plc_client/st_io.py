@@ -128,9 +128,10 @@ class StLogic:
         self.outputs = tuple(e.name for e in self.binding.output_entries)
         from weakref import WeakKeyDictionary
 
-        from structured_text.runtime import parse_address
+        from structured_text.runtime import address_key, parse_address
 
-        self._keys = {v.address: parse_address(v.address)[1:] for v in self.binding.variables}  # the runtime's
+        self._keys = {v.address: address_key(*parse_address(v.address))  # the runtime's image keys
+                      for v in self.binding.variables}
         self._last: WeakKeyDictionary = WeakKeyDictionary()  # per PLC: the input values last written
         self.settings = dict(settings or {})
         self.instance = self.compiled.program.instances[0].name if self.compiled.program.instances else ""
@@ -169,7 +170,7 @@ class StLogic:
 
     def __call__(self, inputs: Mapping, plc) -> dict:
         """One scan. The input image is written straight into the runtime's (`Plc.inputs`, keyed as its
-        `parse_address` keys an address), only for the values that changed since the last scan."""
+        `address_key` keys an address), only for the values that changed since the last scan."""
         last = self._last.get(plc)
         if last is None or not plc.inputs:  # a new PLC, or one restarted cold (its input image cleared)
             last = self._last[plc] = {}

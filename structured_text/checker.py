@@ -89,6 +89,7 @@ class _Scope:
         self.pou = pou
         self.checker = checker
         self.loops = 0
+        self.eno_ok = False  # checking the whole right side of an assignment: ENO may be connected
         self.for_vars: list = []  # the control variables of the FOR loops being checked
 
     def lookup(self, name: str) -> Symbol | None:
@@ -146,10 +147,11 @@ class Checker:
             for p in f.pous:
                 up = p.name.upper()
                 if up in self.pous or up in STANDARD_FBS or up in ty.ELEMENTARY or up in self.type_decls:
-                    self.errors.append(self.fail(f"'{p.name}' is declared twice (or names a standard type or block)", p.span))
+                    self.errors.append(self.fail(f"'{p.name}' is declared twice (or names a standard type or block)",
+                                                 p.name_span or p.span))
                     continue
                 if p.kind == "FUNCTION" and stdlib_fn.is_standard(up):
-                    self.errors.append(self.fail(f"'{p.name}' is the name of a standard function", p.span))
+                    self.errors.append(self.fail(f"'{p.name}' is the name of a standard function", p.name_span or p.span))
                     continue
                 self.pous[up] = PouInfo(p, p.name, p.kind)
         # the order: FB and program types (a TYPE, a global or a member may be an instance of one), the
@@ -467,10 +469,12 @@ class Checker:
     def stmt(self, st: n.Stmt, scope: _Scope) -> None:
         if isinstance(st, n.Assign):
             tt = self.lvalue(st.target, scope)
-            if isinstance(st.target, n.Name) and st.target.ref in scope.for_vars:
-                raise self.fail(f"'{st.target.name}' is the control variable of the FOR loop around it: "
-                                "the loop alone changes it", st.target.span)
-            vt = self.expr(st.value, scope, tt)
+            self.not_a_for_variable(st.target, scope)
+            scope.eno_ok = isinstance(st.value, n.Call)  # `y := F(EN := e, x := 1, ENO => ok)`
+            try:
+                vt = self.expr(st.value, scope, tt)
+            finally:
+                scope.eno_ok = False
             self.need_assignable(tt, vt, st.value, "the assignment")
         elif isinstance(st, n.CallStmt):
             self.call(st.call, scope, statement=True)
@@ -484,6 +488,7 @@ class Checker:
             self.case(st, scope)
         elif isinstance(st, n.For):
             vt = self.lvalue(st.var, scope)
+            self.not_a_for_variable(st.var, scope)
             if vt.kind not in ("int", "bits"):
                 raise self.fail(f"a FOR loop counts with an integer variable, not a {vt}", st.var.span)
             for e in (st.start, st.end, st.step):
@@ -516,6 +521,13 @@ class Checker:
             pass
         else:
             raise AssertionError(st)
+
+    def not_a_for_variable(self, e: n.Expr, scope: _Scope) -> None:
+        """The standard: a FOR loop's control variable is not altered by the statements it repeats (an
+        assignment, an inner FOR, an output or in-out argument)."""
+        if isinstance(e, n.Name) and e.ref is not None and e.ref in scope.for_vars:
+            raise self.fail(f"'{e.name}' is the control variable of the FOR loop around it: "
+                            "the loop alone changes it", e.span)
 
     def condition(self, e: n.Expr, scope: _Scope, what: str) -> None:
         t = self.expr(e, scope, ty.BOOL)
@@ -822,6 +834,7 @@ class Checker:
         """The standard's EN input and ENO output of a call: taken out of the arguments (c.en, c.eno).
         EN FALSE: the call does not run (a function gives its type's default), ENO FALSE."""
         c.en = c.eno = None
+        eno_allowed, scope.eno_ok = statement or scope.eno_ok, False  # only the outermost call of a right side
         rest = []
         for a in c.args:
             name = (a.name or "").upper()
@@ -830,9 +843,9 @@ class Checker:
                     raise self.fail("EN is a BOOL", a.value.span)
                 c.en = a.value
             elif name == "ENO" and a.output:
-                if not statement:
-                    raise self.fail("ENO of a call inside an expression is not supported: call it as a statement",
-                                    a.span)
+                if not eno_allowed:
+                    raise self.fail("ENO of a call inside an expression is not supported: call it as a statement "
+                                    "or the whole right side of an assignment", a.span)
                 if self.lvalue(a.value, scope).kind != "bool":
                     raise self.fail("ENO is a BOOL", a.value.span)
                 c.eno = a.value
@@ -867,6 +880,7 @@ class Checker:
                 if not a.output:
                     raise self.fail(f"'{p.name}' is an output: connect it with {p.name} => variable", a.span)
                 vt = self.lvalue(a.value, scope)
+                self.not_a_for_variable(a.value, scope)
                 if not ty.assignable(vt, p.type if not a.negated else ty.BOOL):
                     raise self.fail(f"output '{p.name}' is a {p.type}, it cannot be stored in a {vt}", a.value.span)
             else:
@@ -874,6 +888,7 @@ class Checker:
                     raise self.fail(f"'{p.name}' is an input: give it with {p.name} := value", a.span)
                 if p.section == "VAR_IN_OUT":
                     vt = self.lvalue(a.value, scope)
+                    self.not_a_for_variable(a.value, scope)
                     if not ty.same_type(vt, p.type) and not ty.assignable(p.type, vt):
                         raise self.fail(f"in-out '{p.name}' is a {p.type}, not a {vt}", a.value.span)
                 else:

@@ -229,6 +229,16 @@ class Compiler:
                     self.assign(st.target, r, st.value.ty, fits=False)
                 self.guarded(st.value, call)
                 return
+            v = st.value
+            if isinstance(v, n.Call) and getattr(v, "eno", None) is not None:  # `y := F(EN := e, ENO => ok)`
+                en = o.temp("en")
+                o.emit(f"{en} = {self.expr(v.en)[0] if v.en is not None else 'True'}")
+                saved, v.en = v.en, None
+                code, fits = self.call_expr(v)
+                v.en = saved
+                self.assign(st.target, f"({code} if {en} else {self.initial(v.ty, None)})", v.ty, fits)
+                self.assign(v.eno, en, ty.BOOL, True)
+                return
             code, fits = self.expr(st.value)
             self.assign(st.target, code, st.value.ty, fits)
         elif isinstance(st, n.CallStmt):
@@ -345,9 +355,13 @@ class Compiler:
         elif step_const < 0:
             lo, hi = hi, lo
         sym = st.var.ref
+        outer = self.loop_vars.get(id(sym))
         self.loop_vars[id(sym)] = (var, lo, hi)  # the body reads the control variable from the Python local
         self.block(st.body)
-        del self.loop_vars[id(sym)]
+        if outer is None:
+            del self.loop_vars[id(sym)]
+        else:
+            self.loop_vars[id(sym)] = outer
         o.level -= 1
         o.emit("else:")
         o.level += 1

@@ -248,6 +248,7 @@ class Pou:
     body: list[Stmt]
     result: TypeSpec | None = None  # a FUNCTION's result type
     end_span: Span | None = None
+    name_span: Span | None = None
 
 
 @dataclass(eq=False)

@@ -128,7 +128,7 @@ class Parser:
         end = self.closing(_POU_END[kind], kw)
         if self.tok.is_op(";"):  # tolerated: `END_PROGRAM;`
             self.advance()
-        return n.Pou(kw.span, kind, name.text, decls, body, result, end.span)
+        return n.Pou(kw.span, kind, name.text, decls, body, result, end.span, name.span)
 
     def var_block(self) -> list[n.VarDecl]:
         head = self.advance()

@@ -52,6 +52,23 @@ def _f32(x):
         return _m.inf if x > 0 else -_m.inf
 
 
+def _rtoi(x, lo, hi, site, truncate=False):
+    """REAL to an integer type: to the nearest (halves to even) or toward zero; out of the type's range
+    (or NaN) is a runtime error, not a wrapped number."""
+    if x != x or not lo - 1 < x < hi + 1:
+        raise Fault(f"{x!r} does not fit the integer type ({lo}..{hi})", site)
+    v = int(x) if truncate else round(x)
+    if not lo <= v <= hi:
+        raise Fault(f"{x!r} does not fit the integer type ({lo}..{hi})", site)
+    return v
+
+
+def _shift(x, n, mask, left, site):
+    if n < 0:
+        raise Fault(f"{'SHL' if left else 'SHR'} by a negative count ({n})", site)
+    return (x << n) & mask if left else (x & mask) >> n
+
+
 def _round(x):
     """REAL to integer: to the nearest, halves to the even neighbour."""
     if x != x or x in (_m.inf, -_m.inf):
@@ -103,7 +120,7 @@ def _expt(a, b, site):
                 return _trunc(a ** b)
             return a ** b
         r = float(a) ** b
-        return r.real if isinstance(r, complex) else r
+        return _m.nan if isinstance(r, complex) else r  # a negative base to a fractional power: invalid
     except OverflowError:
         return _m.inf
     except ZeroDivisionError:

@@ -240,7 +240,8 @@ class Plc:
                     self.fault = PlcFault(f.message, self.compiled.sites.spans[f.site], task.name, name)
                 except RecursionError:
                     self.fault = PlcFault("calls nested too deeply (recursion)", None, task.name, name)
-                except (OverflowError, ValueError, TypeError, ZeroDivisionError) as exc:
+                except (OverflowError, ValueError, TypeError, ZeroDivisionError, IndexError, KeyError,
+                        AttributeError) as exc:
                     self.fault = PlcFault(_describe(exc), self._where(exc), task.name, name)
                 if self.fault is not None:
                     raise self.fault

@@ -251,12 +251,12 @@ def generate(name: str, codes: list[str], ts: list[ty.DataType], result: ty.Data
         return stdlib_wrap(result, f"_bcd_{b[0]}({codes[0]}, {site})")
     conv = conversion(up)
     if conv:
-        return convert(codes[0], ts[0], result, truncate="TRUNC" in up)
+        return convert(codes[0], ts[0], result, truncate="TRUNC" in up, site=site)
     c = codes
     if up == "TIME":
         return "_clk.now"
     if up == "TRUNC":
-        return f"_trunc({c[0]})"
+        return f"_rtoi({c[0]}, {-(1 << 31)}, {(1 << 31) - 1}, {site}, True)"
     if up == "ABS":
         return f"abs({c[0]})"
     if up in _MATH1:
@@ -293,10 +293,8 @@ def generate(name: str, codes: list[str], ts: list[ty.DataType], result: ty.Data
         return "(" + f" {_LOGIC[up]} ".join(c) + ")"
     bits = result.bits if hasattr(result, "bits") and result.kind in ("bits", "int") else 64
     mask = (1 << bits) - 1
-    if up == "SHL":
-        return f"(({c[0]} << {c[1]}) & {mask})"
-    if up == "SHR":
-        return f"(({c[0]} & {mask}) >> {c[1]})"
+    if up in ("SHL", "SHR"):
+        return f"_shift({c[0]}, {c[1]}, {mask}, {up == 'SHL'}, {site})"
     if up in ("ROL", "ROR"):
         return f"_rot({c[0]}, {c[1]}, {bits}, {up == 'ROL'})"
     if up == "SEL":
@@ -333,13 +331,16 @@ def generate(name: str, codes: list[str], ts: list[ty.DataType], result: ty.Data
     raise AssertionError(up)
 
 
-def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = False) -> str:
-    """Python converting a value of type src to type dst."""
+def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = False, site: int | None = None) -> str:
+    """Python converting a value of type src to type dst (`site`: where a REAL out of an integer's range stops)."""
     sk, dk = src.kind, dst.kind
     if dk == "bool":
         return f"({code} != 0)" if sk != "string" else f"({code}.upper() == 'TRUE')"
     if dk in ("int", "bits"):
         if sk == "real":
+            if site is not None:
+                lo, hi = ty.range_of(dst)
+                return f"_rtoi({code}, {lo}, {hi}, {site}, {truncate})"
             inner = f"_trunc({code})" if truncate else f"_round({code})"
         elif sk == "bool":
             return f"int({code})"

@@ -29,7 +29,9 @@ def json_value(t: ty.DataType, v):
     if k in ("int", "bits"):
         return int(v)
     if k == "real":
-        if t.bits == 32 and v == v and v not in (float("inf"), float("-inf")):
+        if v != v or v in (float("inf"), float("-inf")):
+            return "NaN" if v != v else ("Infinity" if v > 0 else "-Infinity")  # JSON has no such numbers
+        if t.bits == 32:
             return float(_np_f32_repr(v))
         return float(v)
     if k == "time":

@@ -52,10 +52,6 @@ RUNTIME_PRESENT = _runtime_present()
 # Cases that fail because of a runtime bug not fixed yet: path -> the entry of /work/team/st-bugs.md.
 # Strict: once the runtime is fixed the xfail turns into a failure, and the entry here must go.
 KNOWN_BUGS: dict[str, str] = {
-    "errors/for_variable_passed_in_out.st": "st-bugs.md #14: a FOR variable passed to a VAR_IN_OUT is not refused",
-    "errors/nested_for_same_variable.st": "st-bugs.md #15: an inner FOR reusing the outer's variable crashes",
-    "errors/duplicate_pou.st": "st-bugs.md #17: a POU declared twice is reported at its keyword, not its name",
-    "expressions/not_a_number.st": "st-bugs.md #16: EXPT of a negative base to a fractional power is not NaN",
 }
 
 REAL_TOLERANCE = 1e-6

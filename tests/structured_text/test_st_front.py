@@ -133,3 +133,10 @@ def test_calls_are_checked_against_the_block():
     assert errs[1].startswith("4:") and "no parameter 'XX'" in errs[1]
     assert errs[2].startswith("5:1") and "output" in errs[2]
     assert errs[3].startswith("6:") and "statement" in errs[3]
+
+
+def test_the_for_variable_is_changed_by_its_loop_alone():
+    src = body("FOR a := 1 TO 3 DO\n  FOR a := 1 TO 2 DO b := a; END_FOR;\n  a := 2;\nEND_FOR;")
+    errs = check_errors(src)
+    assert errs[0].startswith("4:7 ") and "control variable" in errs[0]
+    assert errs[1].startswith("5:3 ") and "control variable" in errs[1]

@@ -307,3 +307,35 @@ END_CONFIGURATION
     plc.scan_ns(0)
     plc.scan_ns(10 * MS)
     assert (plc.get("m.p.n"), plc.get("m.p.a.s"), plc.get("m.arr[4]"), plc.get("m.k")) == (16, 4, 16, 5)
+
+
+def test_a_real_too_large_for_an_integer_stops_the_plc(tmp_path):
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR r : REAL := 1.0E10; i : INT; n : REAL; END_VAR
+n := SQRT(-1.0);
+i := REAL_TO_INT(r);
+END_PROGRAM
+""")
+    with pytest.raises(PlcFault) as e:
+        plc.scan_ns(0)
+    assert (e.value.span.line, e.value.span.col) == (5, 6) and "does not fit" in e.value.message
+    assert plc.resolve("n").json() == "NaN"  # IEC 60559's invalid operation, as a JSON string
+
+
+def test_eno_of_a_function_on_the_right_of_an_assignment(tmp_path):
+    plc = plc_of(tmp_path, """
+FUNCTION Twice : INT
+VAR_INPUT v : INT; END_VAR
+Twice := v * 2;
+END_FUNCTION
+PROGRAM main
+VAR e, ok : BOOL; y : INT := 3; END_VAR
+y := Twice(EN := e, v := 5, ENO => ok);
+END_PROGRAM
+""")
+    plc.scan_ns(0)
+    assert (plc.get("y"), plc.get("ok")) == (0, False)
+    plc.set("e", True)
+    plc.scan_ns(10 * MS)
+    assert (plc.get("y"), plc.get("ok")) == (10, True)
