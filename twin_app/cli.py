@@ -82,7 +82,42 @@ def cmd_info(args) -> int:
     print(f"fingers ({len(mech.fingers)}): " + ", ".join(f.label for f in mech.fingers))
     for line in _remarks(mech):
         print(line)
+    if Path(args.target).suffix.lower() != ".urdf":
+        _print_drives(args.target)
     return 0
+
+
+def _print_drives(target: str) -> None:
+    """The station's drives as the twin derives them (docs/station-format.md, "Drives"), and the URDF data it
+    replaced: this loads the station's physics."""
+    import logging as _logging
+
+    from twin.core import Twin
+
+    quiet = _logging.getLogger("twin")
+    level, quiet.disabled = quiet.disabled, True  # its warnings are listed below, once
+    try:
+        with Twin.from_station(target) as twin:
+            drives, notes = twin.gripper.drives, twin.world.inertia_notes
+            unit = twin.gripper.unit
+    finally:
+        quiet.disabled = level
+    rows = [("drive", "velocity", "effort", "stiffness", "damping", "full force at", "moves", "stable up to")]
+    for name, d in drives.items():
+        u, m = unit[name], unit[name] == "m"
+        rows.append((name, f"{d.velocity:g} {u}/s", f"{d.effort:g} {'N' if m else 'N m'}",
+                     f"{d.stiffness:.4g} {'N/m' if m else 'N m/rad'}" + (" (rigid)" if d.stiffness > d.limit else ""),
+                     f"{d.damping:.4g} {'N s/m' if m else 'N m s/rad'}",
+                     f"{d.full_error * (1000 if m else 1):.3g} {'mm' if m else 'rad'}",
+                     f"{d.mass:.4g} {'kg' if m else 'kg m^2'}", f"{d.limit:.4g}"))
+    widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
+    print("drives (derived from the masses, the effort and the step; docs/station-format.md, Drives):")
+    for n, row in enumerate(rows):
+        print("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        if n == 0:
+            print("  " + "  ".join("-" * w for w in widths))
+    for note in notes:
+        print(f"warning: {note}")
 
 
 def cmd_demo(args) -> int:

@@ -29,18 +29,19 @@ class Grip:
     closing: str = "outside"  # "outside" (status 2 when stalled) or "inside" (into a bore: status 1)
 
 
-GRIPS = {
-    "newcomer_2f": Grip("can", {"finger_left": 0.005, "finger_right": 0.005}, {"finger_left": 40.0, "finger_right": 40.0}),
-    "newcomer_2f_box": Grip("box", {"finger_left": 0.005, "finger_right": 0.005},
+GRIPS = {  # every finger closed to its range's end: well past the part, so each presses with its drive's effort
+    "newcomer_2f": Grip("can", {"finger_left": 0.0, "finger_right": 0.0}, {"finger_left": 40.0, "finger_right": 40.0}),
+    "newcomer_2f_box": Grip("box", {"finger_left": 0.0, "finger_right": 0.0},
                             {"finger_left": 40.0, "finger_right": 40.0}),
-    "newcomer_2f_steel": Grip("slug", {"finger_left": 0.0025, "finger_right": 0.0025},
+    "newcomer_2f_steel": Grip("slug", {"finger_left": 0.0, "finger_right": 0.0},
                               {"finger_left": 40.0, "finger_right": 40.0}),
-    "parallel_200n": Grip("block", {"jaw_a": 0.015}, {"jaw_a": 100.0, "jaw_b": 100.0}),
-    "revolute_chuck": Grip("disc", {"jaw_1": -0.3, "jaw_2": -0.3, "jaw_3": -0.3}, {"jaw_1": 2.0, "jaw_2": 2.0, "jaw_3": 2.0}),
-    "revolute_chuck_bore": Grip("ring", {"jaw_1": 0.3, "jaw_2": 0.3, "jaw_3": 0.3},
+    "parallel_200n": Grip("block", {"jaw_a": 0.0}, {"jaw_a": 100.0, "jaw_b": 100.0}),
+    "revolute_chuck": Grip("disc", {"jaw_1": -0.35, "jaw_2": -0.35, "jaw_3": -0.35},
+                           {"jaw_1": 2.0, "jaw_2": 2.0, "jaw_3": 2.0}),
+    "revolute_chuck_bore": Grip("ring", {"jaw_1": 0.35, "jaw_2": 0.35, "jaw_3": 0.35},
                                 {"jaw_1": 2.0, "jaw_2": 2.0, "jaw_3": 2.0}, "inside"),
-    "light_5n": Grip("cube", {"jaw_left": 0.005, "jaw_right": 0.005}, {"jaw_left": 5.0, "jaw_right": 5.0}),
-    "sloppy_inertia": Grip("cylinder", {"finger_1_link": 0.015, "finger_2_link": 0.015},
+    "light_5n": Grip("cube", {"jaw_left": 0.0, "jaw_right": 0.0}, {"jaw_left": 5.0, "jaw_right": 5.0}),
+    "sloppy_inertia": Grip("cylinder", {"finger_1_link": 0.0, "finger_2_link": 0.0},
                            {"finger_1_link": 50.0, "finger_2_link": 50.0}),
 }
 

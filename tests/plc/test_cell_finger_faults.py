@@ -78,5 +78,6 @@ def test_a_ring_that_slips_out_while_carried_is_no_longer_reported_held(tmp_path
     # the robot, told by diGripOk, stops above the left pallet instead of placing a ring it no longer carries
     assert "robot: The gripper PLC no longer holds the ring" in text and "release" not in text
     assert s.stopped and s.plc_faults == ["lost"]
-    # the physics agrees: the ring is not where the robot would have placed it (the left pallet, 1600 mm away)
-    assert s.ring_end is not None and s.ring_end[1] < -300.0
+    # the physics agrees: the ring is not where the robot would have placed it (the left pallet, 1600 mm away,
+    # whose near edge is at y = +300 mm; where on the way it falls is the dynamics of a two-finger slide, not statics)
+    assert s.ring_end is not None and s.ring_end[1] < 300.0

@@ -3,18 +3,25 @@
 The drive model (docs/station-format.md, "Drives"). Every input is a servo drive:
 - its *command* moves towards the setpoint at the velocity limit (a ramp), and runs ahead of the joint by no more
   than the error at which the drive reaches its force limit, so a new setpoint acts at once;
-- a position loop of stiffness K turns the following error e = command - actual into at most K * |e| (+ a
-  small holding force), limited by the effort: |F| <= min(effort, K |e| + HOLD_FRACTION * effort);
-- within that force it drives the joint at the command's speed plus the error taken out over a few substeps
-  (pybullet's implicit velocity motor: stable for any finger mass, as a stiff velocity loop is).
-A free finger follows its command with almost no force. A finger stopped by a part cannot follow: its error
-and so its force grow until the part's reaction balances them, the way a servo with finite stiffness presses;
-a finger pushed back by the others yields until K |e| carries the push. What the PLC reads is measured, not
-computed: `NAME.effort` is the motor force pybullet applied (averaged over the substeps), `NAME.force` the
-normal force of the finger's contacts on target objects (averaged over the substeps; a revolute finger's is the
-torque of those forces about its joint). Mimic joints are tied to their master by a gear constraint (one motor
-moves the whole linkage). Stepping by hand (fixedTimeStep = step / substeps, one stepSimulation per substep)
-keeps both motor limits and contact forces true (measured-facts.md: numSubSteps distorts both).
+- a position loop of stiffness K and damping D asks for |K e - D v| (+ a small holding force), e = command - actual,
+  v the joint's speed, limited by the effort; within that force pybullet's implicit velocity motor drives the joint
+  to the command in one substep (stable for any finger mass); a drive held back at its force limit asks for far more
+  speed (the solver builds a motor's force only as fast as the speed it asks for);
+- a drive stalled on a part (95 % of its full-force error, short of its goal, its finger pressing on a target) keeps
+  its command where it stands until its force falls by a tenth or the goal changes: the finger holds its place, and
+  the rest of its effort resists a push, so two fingers squeezing a part cannot walk it sideways.
+The gains are derived, not tuned (`_derive_drives`): K and D act explicitly, once per substep h, on what the drive
+moves, m (its links, its mimic followers', and the lightest target when it carries a finger; about a revolute axis,
+their inertia and the target at the finger's reach), shared by the n fingers' own drives: K <= m / (n h^2) (below
+that the spring is stable), D = m / (n h). A station's stiffness above that limit makes its drive rigid up to its
+effort. A free finger follows its command with almost no force; a finger stopped by a part presses with K times how
+far its setpoint lies past it, up to the effort. What the PLC reads is measured, not computed: `NAME.effort` is the
+motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
+target objects (averaged over the substeps; a revolute finger's is the torque of those forces about its joint),
+and an axis's speed comes from its positions (pybullet's joint velocity reads the motor's target where a contact
+holds the joint back). Mimic joints are tied to their master by a gear constraint (one motor moves the whole
+linkage). Stepping by hand (fixedTimeStep = step / substeps, one stepSimulation per substep) keeps both motor limits
+and contact forces true (measured-facts.md: numSubSteps distorts both).
 
 The grip rule (`sense`, after each step), the same for outside and inside grips:
 - contact: a finger touches a target when their closest distance (with 0.1 mm collision margins, so corners
@@ -25,10 +32,11 @@ The grip rule (`sense`, after each step), the same for outside and inside grips:
 - `grip = "friction"`: nothing is welded, the part is held by friction alone and may slip or drop;
   `grip = "attach"`: the part is fixed to the base link while every finger presses on it with at least
   `attach_force`, released when any finger's force falls below it (the thesis's SmartComponent, honestly);
-- `slip`: a gripped part has moved more than `slip_distance` relative to the base link since it was gripped
-  (latched until the next grip);
-- `NAME.status` per finger, as a Robotiq gripper's object status: 0 moving towards the setpoint, 1 stopped by
-  contact while opening, 2 stopped by contact while closing, 3 at the setpoint.
+- `slip`: a gripped part has moved more than `slip_distance` relative to the palm (the link every finger hangs
+  from: the base link, unless an axis such as a lift carries all the fingers) since it was gripped (latched until
+  the next grip);
+- `NAME.status` per finger, as a Robotiq gripper's object status: 0 moving towards the setpoint (while any axis that
+  carries it moves), 1 stopped by contact while opening, 2 stopped by contact while closing, 3 at the setpoint.
 """
 from __future__ import annotations
 
@@ -44,12 +52,14 @@ from .station import GripperSpec
 from .world import COLLISION_MARGIN
 
 DEFAULT_VELOCITY = {"m": 0.1, "rad": 1.0}  # when the URDF gives no velocity limit
-FULL_FORCE_ERROR = {"m": 0.001, "rad": 0.01}  # default stiffness: the effort limit at this following error
+FULL_FORCE_ERROR = {"m": 0.001, "rad": 0.01}  # default stiffness: the effort limit at this following error ...
+STIFFNESS_SHARE = 1.0  # ... at most this share of the stiffest spring the step keeps stable: K h^2 / m per drive
+DAMPING_SHARE = 1.0  # the damping: this share of the strongest the step keeps stable, D h / m per drive
 HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
-POSITION_GAIN = 0.3  # the velocity loop takes this share of the following error out per substep
-SPEED_MARGIN = 1.0  # the drive never runs faster than its velocity limit (a lag is taken out at the end of a move)
-BLOCKED_SHARE = 0.25  # a drive standing with this share of its full-force error (or two substeps' travel) is held back
-BLOCKED_SPEEDUP = 20.0  # how much faster than its limit a held-back drive asks to move (it cannot: it presses)
+PUSH_SPEEDUP = 20.0  # how much faster than its velocity limit a held drive asks to move
+LATCH_FRACTION = 0.95  # a drive pressing with this share of its full-force error stalls: its command waits there,
+# and the last 5 % of its effort hold the finger where it stands against a push from the other side
+RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
 GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's drive effort
@@ -85,11 +95,15 @@ class GripState:
 
 @dataclass(frozen=True)
 class Drive:
-    """One input's servo drive: velocity limit, force limit, stiffness (see the module docstring)."""
+    """One input's servo drive: velocity limit, force limit, stiffness and damping of its position loop, and the
+    mass (or inertia about its axis) the loop was derived for (see the module docstring)."""
 
     velocity: float
     effort: float
     stiffness: float
+    damping: float = 0.0
+    mass: float = 0.0  # kg (kg m^2 for a revolute drive): what it moves, with the lightest target
+    limit: float = float("inf")  # the stiffest spring the step keeps stable for that mass (N/m or N m/rad)
 
     @property
     def full_error(self) -> float:
@@ -102,23 +116,26 @@ class Gripper:
 
     def __init__(self, client, body: int, joint_index: dict[str, int], link_index: dict[str, int],
                  mechanism: Mechanism, spec: GripperSpec, targets: dict[str, int], substep: float,
-                 contact_probe=None):
+                 contact_probe=None, substeps: int = 1):
         self.client, self.body, self.mechanism, self.spec = client, body, mechanism, spec
         self.targets = targets  # target name -> body id, in station order
         self._target_by_id = {uid: name for name, uid in targets.items()}
         self.base_link = link_index[mechanism.base_link]
         self.h = substep
+        self.substeps = substeps  # physics substeps in one simulation step
         self.names = [inp.name for inp in mechanism.inputs]
         self.joint = {inp.name: joint_index[inp.joint] for inp in mechanism.inputs}
         self._joint_ids = [self.joint[n] for n in self.names]
         self.unit = {inp.name: inp.unit for inp in mechanism.inputs}
+        self._range = {inp.name: (inp.min, inp.max) for inp in mechanism.inputs}
         self.drives: dict[str, Drive] = {}
+        stiffness_given: dict[str, float | None] = {}
         for inp in mechanism.inputs:
             o = spec.joints.get(inp.name)
             velocity = (o.velocity if o and o.velocity else None) or inp.velocity or DEFAULT_VELOCITY[inp.unit]
             effort = (o.effort if o and o.effort else None) or inp.effort or DEFAULT_EFFORT[inp.unit]
-            stiffness = (o.stiffness if o and o.stiffness else None) or effort / FULL_FORCE_ERROR[inp.unit]
-            self.drives[inp.name] = Drive(velocity, effort, stiffness)
+            stiffness_given[inp.name] = o.stiffness if o and o.stiffness else None
+            self.drives[inp.name] = Drive(velocity, effort, stiffness_given[inp.name] or effort / FULL_FORCE_ERROR[inp.unit])
         master_input = {inp.joint: inp.name for inp in mechanism.inputs}
         self.mimics = [(joint_index[m.joint], master_input[m.master], m.multiplier, m.offset) for m in mechanism.mimics]
         self.finger_links = {f.name: [link_index[n] for n in f.links] for f in mechanism.fingers}
@@ -132,6 +149,15 @@ class Gripper:
         self.finger_servos = {f.name: list(dict.fromkeys(servo_of[j] for j in self._chain(joint_index[f.joint])
                                                           if j in servo_of))
                               for f in mechanism.fingers}
+        # the palm: the link every finger hangs from (the base link, unless an axis such as a lift carries them
+        # all): a held part is watched for slip, and attached, relative to it
+        chains = [self._chain(joint_index[f.joint]) for f in mechanism.fingers]
+        own = set(self.finger_joint.values())
+        common = [j for j in chains[0] if j not in own and all(j in ch for ch in chains[1:])] if chains else []
+        self.palm_link = common[0] if common else self.base_link
+        self._fingers_of_servo = {name: [f for f, servos in self.finger_servos.items() if name in servos]
+                                  for name in self.names}
+        self._derive_drives(stiffness_given)
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
         self.grip_force = {f: spec.grip_force if spec.grip_force is not None
@@ -143,6 +169,8 @@ class Gripper:
         self.active_input = spec.always_active  # the `Active` input as last written
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
+        self._stalled: dict[str, float | None] = {}  # input -> the direction it presses in, while stalled on a part
+        self._new_goal: set[str] = set()  # inputs given a setpoint since their drive last ran
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
         self._grip_reference: tuple | None = None  # the gripped part's pose in the base link's frame at the grip
@@ -169,6 +197,10 @@ class Gripper:
         # the joints' states as last read (after the last physics substep: what the next drive starts from), and
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
         self._states = None
+        self._speeds = [0.0] * len(self.names)  # each joint's speed over the last physics substep(s) measured
+        self._ticks = 0  # physics substeps since the joints were last read
+        self._step_positions: list[float] | None = None  # the joints' positions at the end of the last step
+        self._step_ticks = 0  # physics substeps since the last sense
         self._sent: tuple | None = None
         self._per_input = [(name, self.unit[name], MOVING_SPEED[self.unit[name]]) for name in self.names]
         self._joint_axis = {f: client.getJointInfo(body, j)[13] for f, j in self.finger_joint.items()}
@@ -192,6 +224,7 @@ class Gripper:
     def set_setpoint(self, name: str, value: float) -> None:
         """Validate and store a setpoint; it takes effect at the next step. Out of range: rejected."""
         self.setpoint[name] = self.check(self.mechanism.input(name), value)
+        self._new_goal.add(name)
 
     @property
     def limits(self) -> dict[str, tuple[float, float]]:
@@ -206,7 +239,8 @@ class Gripper:
             if value is not None and not (value >= 0.0 and value < float("inf")):
                 raise ValueError(f"{name}: the {what} limit must be a finite number >= 0, not {value!r}")
         self.drives[name] = Drive(d.velocity if velocity is None else float(velocity),
-                                  d.effort if effort is None else float(effort), d.stiffness)
+                                  d.effort if effort is None else float(effort), d.stiffness, d.damping, d.mass,
+                                  d.limit)
 
     def set_active(self, active: bool) -> None:
         """Store the `Active` input; an always-active gripper keeps what was written but ignores it."""
@@ -217,6 +251,78 @@ class Gripper:
         return self.active_input or self.spec.always_active
 
     # -- set-up ---------------------------------------------------------------------------------------------
+    def _derive_drives(self, stiffness_given: dict[str, float | None]) -> None:
+        """Each drive's stiffness and damping from what it moves (module docstring, "Derived gains"): the mass of
+        the links it carries (a revolute drive: their inertia about its axis), with the lightest target (pressed by
+        a finger, it moves with the finger; about a revolute axis at the finger's reach), shared among the drives
+        that press independently (the fingers' own)."""
+        c, body, h = self.client, self.body, self.h
+        children: dict[int, list[int]] = {}
+        for j in range(c.getNumJoints(body)):
+            children.setdefault(c.getJointInfo(body, j)[16], []).append(j)
+
+        def subtree(j: int) -> list[int]:
+            out, stack = [], [j]
+            while stack:
+                k = stack.pop()
+                out.append(k)
+                stack += children.get(k, [])
+            return out
+
+        masses = [c.getDynamicsInfo(uid, -1)[0] for uid in self.targets.values()]
+        part = min((m for m in masses if m > 0), default=0.0)
+        finger_links = set(self._finger_of_link)
+        moved = {}
+        for name in self.names:
+            links = [(k, 1.0) for k in subtree(self.joint[name])]
+            for joint, master, mult, _ in self.mimics:
+                if master == name:
+                    links += [(k, mult) for k in subtree(joint)]
+            moved[name] = links
+        carriers = {name for name in self.names if finger_links & {k for k, _ in moved[name]}}
+        share = max(1, len({servos[0] for servos in self.finger_servos.values() if servos}))  # the fingers' own drives
+        for name in self.names:
+            d, links = self.drives[name], moved[name]
+            fingers = name in carriers
+            if self.unit[name] == "m":
+                mass = sum(mult * mult * c.getDynamicsInfo(body, k)[0] for k, mult in links) + (part if fingers else 0.0)
+                floor = 1e-3
+            else:
+                mass, reach = self._inertia_about_axis(name, links, finger_links)
+                mass += part * reach * reach if fingers else 0.0
+                floor = 1e-7
+            mass = max(mass, floor)
+            limit = STIFFNESS_SHARE * mass / (share * h * h)
+            stiffness = stiffness_given[name] or min(d.effort / FULL_FORCE_ERROR[self.unit[name]], limit)
+            self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * mass / (share * h), mass, limit)
+
+    def _inertia_about_axis(self, name: str, links, finger_links: set[int]) -> tuple[float, float]:
+        """The inertia (kg m^2) about input `name`'s joint axis of the links it moves, and the reach (m) of its
+        fingers: the farthest corner of their bounding boxes from the axis."""
+        c, body = self.client, self.body
+        j = self.joint[name]
+        state = c.getLinkState(body, j, computeForwardKinematics=True)
+        origin, axis = state[4], _rotate(state[5], c.getJointInfo(body, j)[13])
+
+        def off_axis(p) -> float:
+            r = [p[i] - origin[i] for i in range(3)]
+            along = sum(r[i] * axis[i] for i in range(3))
+            return math.sqrt(max(0.0, sum(x * x for x in r) - along * along))
+
+        inertia = reach = 0.0
+        for k, mult in links:
+            info = c.getDynamicsInfo(body, k)
+            link = c.getLinkState(body, k, computeForwardKinematics=True)
+            m = pybullet.getMatrixFromQuaternion(link[1])  # the link's inertial frame in the world
+            local = [sum(m[3 * row + col] * axis[row] for row in range(3)) for col in range(3)]  # the axis in it
+            own = sum(info[2][i] * local[i] * local[i] for i in range(3))
+            inertia += mult * mult * (info[0] * off_axis(link[0]) ** 2 + own)
+            if k in finger_links:
+                lo, hi = c.getAABB(body, k)
+                for corner in ((x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])):
+                    reach = max(reach, abs(mult) * off_axis(corner))
+        return inertia, reach
+
     def _chain(self, joint: int) -> list[int]:
         """`joint` and the joints between it and the body's base, nearest first."""
         chain = []
@@ -287,6 +393,8 @@ class Gripper:
         Drives that all stand still at their goal, pressing on nothing, keep the first substep's settings for the
         rest of the step: nothing changes there but cost. The joints' states are those `measure` read after the
         substep before (nothing moves the joints in between)."""
+        self._ticks += 1
+        self._step_ticks += 1
         if substep and self._quiet:
             return
         if not self.active and self._hold is None:
@@ -300,28 +408,48 @@ class Gripper:
             states = self._states = self._joint_states(self.body, self._joint_ids)
         velocities, forces = [], []
         quiet = True
-        drives, command = self.drives, self.command_position
+        drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
+        fingers, axes = self.state.fingers, self.state.axes  # as the last step left them
         for (name, _, moving), (actual, joint_speed, _, _) in zip(self._per_input, states):
             d = drives[name]
+            g = goal[name]
             before = command[name]
-            target = _towards(before, goal[name], d.velocity * h)
-            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
+            if name in turned:
+                turned.discard(name)
+                if (g - actual) * (before - actual) < 0.0:
+                    before = actual  # a new goal the other way: the drive turns at once, from where the joint is
+                    stalled[name] = None
             full = d.effort / d.stiffness
+            way = stalled.get(name)
+            if way is not None and (g - before) * way > 0.0 and (before - actual) * way > RELEASE_FRACTION * full:
+                target = before  # stalled on a part: the command waits, so the finger holds where the part stopped it
+            else:
+                way = None
+                target = _towards(before, g, d.velocity * h)
+            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
             target = min(max(target, actual - full), actual + full)
+            if (target != g and abs(target - actual) >= full * LATCH_FRACTION and (g - actual) * (target - actual) > 0.0
+                    and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers)):
+                way = 1.0 if target > actual else -1.0  # held short of its goal by a part, at its force limit: stalled
+            stalled[name] = way
             command[name] = target
             error = target - actual
-            limit = SPEED_MARGIN * d.velocity
-            speed = min(max((target - before) / h + POSITION_GAIN * error / h, -limit), limit)
-            standing = abs(joint_speed) < moving
-            if standing and abs(error) > max(BLOCKED_SHARE * full, 2 * d.velocity * h):
-                # held back by a part: pybullet's solver builds a motor's force only as fast as the velocity it asks
-                # for, so a held-back drive asks for far more; its force limit is then what it presses with
-                speed = BLOCKED_SPEEDUP * d.velocity * (1.0 if error > 0 else -1.0)
+            toward = joint_speed if error > 0.0 else -joint_speed
+            speed = error / h  # to be at the command after the substep, as far as the force allows
+            if abs(error) >= full * (1.0 - 1e-9) and toward <= 0.0:
+                # at its force limit and held (or pushed) back: pybullet's solver builds a motor's force only as fast
+                # as the speed it asks for, so a held drive asks for far more than it can have: it presses at its limit
+                speed = max(abs(speed), PUSH_SPEEDUP * d.velocity) * (1.0 if error > 0.0 else -1.0)
             velocities.append(speed)
-            forces.append(min(d.effort, d.stiffness * abs(error) + HOLD_FRACTION * d.effort))
-            quiet = (quiet and before == goal[name] and standing
-                     and abs(error) < BLOCKED_SHARE * full)  # a drive pressing on a part is followed every substep
+            if d.stiffness > d.limit:  # stiffer than the step resolves (a station's choice): rigid up to its effort
+                forces.append(d.effort)
+            else:
+                forces.append(min(d.effort, abs(d.stiffness * error - d.damping * joint_speed) + HOLD_FRACTION * d.effort))
+            quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
+                     and d.stiffness * abs(error) <= HOLD_FRACTION * d.effort)  # a pressing drive: every substep
         self._quiet = quiet
+        if quiet and substep == 0 and self.substeps > 1:  # these settings hold for the whole step: the small error
+            velocities = [v / self.substeps for v in velocities]  # left is taken out over it, not in every substep
         sent = (velocities, forces)
         if sent != self._sent:  # pybullet keeps a motor's command: the same one needs no call
             self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
@@ -339,7 +467,13 @@ class Gripper:
         if self._quiet and not last:
             return
         self._n += 1
+        before = self._states
         states = self._states = self._joint_states(self.body, self._joint_ids)
+        if before is not None:  # how fast each joint moved, from its positions: pybullet's joint velocity reads the
+            # motor's target where a contact or a stop holds the joint back by position correction
+            elapsed = self._ticks * self.h
+            self._speeds = [(s[0] - b[0]) / elapsed for s, b in zip(states, before)]
+        self._ticks = 0
         efforts = self._effort_sum
         for i, s in enumerate(states):
             efforts[i] += s[3]
@@ -376,9 +510,14 @@ class Gripper:
         n = max(1, self._n)
         if not self._n:  # no substep measured since the last sense (a new gripper): read the joints now
             self._states = self._joint_states(self.body, self._joint_ids)
+        positions = [s[0] for s in self._states]
+        last = self._step_positions or positions
+        dt = max(1, self._step_ticks) * self.h
+        self._step_positions, self._step_ticks = positions, 0
         axes = {}
-        for i, (name, s) in enumerate(zip(self.names, self._states)):
-            axes[name] = AxisState(s[0], s[1], self._effort_sum[i] / n if self._n else 0.0)
+        for i, (name, q) in enumerate(zip(self.names, positions)):
+            lo, hi = self._range[name]  # the joint's stop: the solver's give at a stop is no position the joint has
+            axes[name] = AxisState(min(max(q, lo), hi), (q - last[i]) / dt, self._effort_sum[i] / n if self._n else 0.0)
         self.state.axes = axes
         pressing: dict[str, dict[str, float]] = {}
         for (finger, uid), total in self._force_sum.items():
@@ -446,31 +585,28 @@ class Gripper:
         return tuple(name for name in self.targets if name in found)
 
     def _status(self, finger: str, axes: dict[str, AxisState], contact: bool) -> int:
-        """The finger's object status, Robotiq's way, from its own drive (the nearest servo that moves it)."""
-        servos = self.finger_servos[finger]
-        if not servos:
-            return STATUS_AT_SETPOINT
-        name = servos[0]
-        goal = self._hold[name] if self._hold is not None else self.setpoint[name]
-        axis, unit = axes[name], self.unit[name]
-        if abs(goal - axis.actual) <= IN_POSITION_TOLERANCE[unit]:
-            return STATUS_AT_SETPOINT
-        d = self.drives[name]
-        # stopped by contact: it stands although its drive pushes with at least half its force limit (a finger
-        # that merely starts to move away from a part it pressed on is not stopped by it)
-        blocked = (abs(axis.velocity) <= MOVING_SPEED[unit]
-                   and abs(self.command_position[name] - axis.actual) >= 0.5 * d.full_error)
-        if not blocked:
-            return STATUS_MOVING
-        closing = (goal - axis.actual) * self.closing[name] > 0
-        return STATUS_CLOSING_CONTACT if closing else STATUS_OPENING_CONTACT
+        """The finger's object status, Robotiq's way, from every servo that moves it: moving while any of them
+        moves; else stopped by contact when one of them (the nearest) stands short of its goal with its drive
+        pushing; else at the setpoint."""
+        stopped = None
+        for name in self.finger_servos[finger]:
+            goal = self._hold[name] if self._hold is not None else self.setpoint[name]
+            axis, unit = axes[name], self.unit[name]
+            tolerance = IN_POSITION_TOLERANCE[unit]
+            if abs(goal - axis.actual) <= tolerance:
+                continue
+            if abs(axis.velocity) > MOVING_SPEED[unit] or abs(self.command_position[name] - axis.actual) <= tolerance:
+                return STATUS_MOVING
+            if stopped is None:
+                stopped = STATUS_CLOSING_CONTACT if (goal - axis.actual) * self.closing[name] > 0 else STATUS_OPENING_CONTACT
+        return STATUS_AT_SETPOINT if stopped is None else stopped
 
     # -- slip -----------------------------------------------------------------------------------------------
     def _base_pose(self):
         c = self.client
-        if self.base_link == -1:
+        if self.palm_link == -1:
             return c.getBasePositionAndOrientation(self.body)
-        return c.getLinkState(self.body, self.base_link, computeForwardKinematics=True)[:2]  # (its centre of mass frame, now)
+        return c.getLinkState(self.body, self.palm_link, computeForwardKinematics=True)[:2]  # (its centre of mass frame, now)
 
     def _relative_pose(self, name: str):
         c = self.client
@@ -497,7 +633,7 @@ class Gripper:
     def _attach(self, name: str) -> None:
         c, uid = self.client, self.targets[name]
         rel_pos, rel_orn = self._relative_pose(name)
-        self._constraint = c.createConstraint(self.body, self.base_link, uid, -1, pybullet.JOINT_FIXED, [0, 0, 0],
+        self._constraint = c.createConstraint(self.body, self.palm_link, uid, -1, pybullet.JOINT_FIXED, [0, 0, 0],
                                               rel_pos, [0, 0, 0], rel_orn, [0, 0, 0, 1])
         c.changeConstraint(self._constraint, maxForce=1e6)
         self.state.attached = name

@@ -66,7 +66,7 @@ class Twin:
         self.step_count = 0
         self.gripper = Gripper(self.world.client, self.world.machine, self.world.joint_index, self.world.link_index,
                                self.mechanism, st.gripper, {t.name: self.world.body_ids[t.name] for t in st.targets},
-                               self.world.substep, self.world.contact_probe)
+                               self.world.substep, self.world.contact_probe, self.world.substeps)
         self.robot = None
         if st.robot is not None:
             from .geometry import Pose

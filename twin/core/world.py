@@ -14,6 +14,7 @@ planar, floating and spherical gripper joints made fixed, as the mechanism treat
 from __future__ import annotations
 
 import functools
+import logging
 import math
 import os
 import tempfile
@@ -173,9 +174,74 @@ def create_body(c, body: Body) -> int:
     uid = c.createMultiBody(baseMass=body.mass, baseCollisionShapeIndex=col, baseVisualShapeIndex=vis,
                             basePosition=body.pose.xyz, baseOrientation=quat(body.pose))
     c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
+    if body.mass > 0:  # friction anchors: a part held or resting by friction stays where friction holds it (without
+        c.changeDynamics(uid, -1, frictionAnchor=1)  # them the solver's friction drifts: a squeezed box walks)
     if body.shape in ("box", "ring"):  # sharp corners; a cylinder keeps pybullet's margin (a thin one makes a
         c.changeDynamics(uid, -1, collisionMargin=COLLISION_MARGIN)  # squeezed one creep; its rims err 0.4 mm)
     return uid
+
+
+INERTIA_SLACK = 10.0  # a link's inertia more than this many times that of the solid box of its collision shapes (or
+# less than its inverse squared) does not fit its mass and size: an exported placeholder (1 kg m^2 on a 50 g finger)
+_warned: set[tuple[str, str]] = set()  # (URDF, link): each warned of once per process
+
+
+def fix_inertias(c, body: int, link_name: dict[int, str], source: str) -> list[str]:
+    """Replace the inertia of every gripper link whose URDF inertia does not fit its mass and collision shapes by
+    that of the solid box around those shapes (about its centre of mass, in its inertial frame); one warning line
+    per link, naming it. A link with no collision shape keeps what the URDF says. Returns the warnings."""
+    notes = []
+    for link, name in sorted(link_name.items()):
+        if name.startswith(ROBOT_PREFIX):
+            continue
+        info = c.getDynamicsInfo(body, link)
+        mass, given = info[0], info[2]
+        shapes = c.getCollisionShapeData(body, link)
+        if mass <= 0.0 or not shapes:
+            continue
+        corners = []
+        for shape in shapes:
+            half = _half_extents(shape[2], shape[3])
+            if half is None:
+                break
+            pos, orn = shape[5], shape[6]
+            for sx in (-1, 1):
+                for sy in (-1, 1):
+                    for sz in (-1, 1):
+                        p, _ = pybullet.multiplyTransforms(pos, orn, (sx * half[0], sy * half[1], sz * half[2]),
+                                                           (0, 0, 0, 1))
+                        corners.append(p)
+        else:
+            lo = [min(p[i] for p in corners) for i in range(3)]
+            hi = [max(p[i] for p in corners) for i in range(3)]
+            size = [hi[i] - lo[i] for i in range(3)]
+            mid = [(hi[i] + lo[i]) / 2 for i in range(3)]
+            box = [mass / 12 * (size[(i + 1) % 3] ** 2 + size[(i + 2) % 3] ** 2)
+                   + mass * (mid[(i + 1) % 3] ** 2 + mid[(i + 2) % 3] ** 2) for i in range(3)]
+            fits = all(b > 0 and b / INERTIA_SLACK ** 2 <= g <= b * INERTIA_SLACK for g, b in zip(given, box))
+            if fits:
+                continue
+            c.changeDynamics(body, link, localInertiaDiagonal=box)
+            note = (f"{source}: link {name}: inertia {' '.join(f'{g:.3g}' for g in given)} kg m^2 does not fit its "
+                    f"{mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the solid "
+                    f"box around them)")
+            notes.append(note)
+            if (source, name) not in _warned:
+                _warned.add((source, name))
+                logging.getLogger("twin").warning("warning: %s", note)
+    return notes
+
+
+def _half_extents(kind: int, dims) -> tuple[float, float, float] | None:
+    """Half the size of a collision shape's bounding box in its own frame (None: a mesh or a plane)."""
+    if kind == pybullet.GEOM_BOX:
+        return dims[0] / 2, dims[1] / 2, dims[2] / 2
+    if kind == pybullet.GEOM_SPHERE:
+        return dims[0], dims[0], dims[0]
+    if kind in (pybullet.GEOM_CYLINDER, pybullet.GEOM_CAPSULE):
+        r, length = dims[1], dims[0]
+        return r, r, length / 2 + (r if kind == pybullet.GEOM_CAPSULE else 0.0)
+    return None
 
 
 HOT_CALLS = ("stepSimulation", "getJointStates", "getJointState", "setJointMotorControlArray", "getContactPoints",
@@ -233,6 +299,7 @@ class World:
             self.joint_index[info[1].decode()] = j
             self.link_index[info[12].decode()] = j
         self.link_name = {j: name for name, j in self.link_index.items()}
+        self.inertia_notes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf))
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
 

@@ -1,0 +1,200 @@
+"""Grippers nobody tuned (issue 18), in real pybullet physics, against statics and geometry: a finger stalled on a
+part settles (status, `moving`, a steady position) and presses with its drive's effort (half of it per jaw of a 1:1
+mimic pair, torque on a revolute lever); contacts stay within 0.5 mm of the nominal shapes; parts stay put; a grip
+holds what friction can carry and drops what it cannot; actuals stay in their joint's range; inertias that do not
+fit a link's mass and size are replaced, with one warning naming the link."""
+import logging
+import math
+
+import pytest
+
+from tests.grippers import GRIPPERS, GRIPS
+from twin.core import Twin
+
+G = 9.81
+SETTLE_STEPS = 10  # a stalled finger reports its stop within this many steps of touching
+
+
+def closest(twin: Twin, finger: str, part: str) -> float:
+    """The closest distance (m) between a finger's links and the part in the physics world (negative: overlap)."""
+    c, w = twin.world.client, twin.world
+    return min((pt[8] for link in twin.gripper.finger_links[finger]
+                for pt in c.getClosestPoints(w.machine, w.body_ids[part], 0.01, linkIndexA=link)), default=1.0)
+
+
+def close_on_part(twin: Twin, name: str):
+    """Close every finger of test gripper `name` past its part; step until all touch it. Returns the grip and
+    the step at which the last finger touched."""
+    grip = GRIPS[name]
+    for inp, value in grip.close.items():
+        twin.write(inp, value)
+    for _ in range(round(1.0 / twin.dt)):
+        twin.step()
+        if all(twin.read(f"{f}.contact") for f in grip.force):
+            return grip, twin.step_count
+    raise AssertionError(f"{name}: the fingers never all touched the {grip.part}")
+
+
+@pytest.mark.parametrize("name", list(GRIPS))
+def test_a_stalled_finger_settles_and_presses_with_its_drive_effort(name):
+    with Twin.from_station(GRIPPERS[name]) as twin:
+        grip, touched = close_on_part(twin, name)
+        stalled = 1 if grip.closing == "inside" else 2
+        for _ in range(SETTLE_STEPS):  # stopped by the part within 10 steps of touching it
+            if all(twin.read(f"{f}.status") == stalled for f in grip.force):
+                break
+            twin.step()
+        assert all(twin.read(f"{f}.status") == stalled for f in grip.force)
+        for _ in range(round(1.0 / twin.dt)):  # the drives build their force as their commands run on, to the limit
+            twin.step()
+            if all(twin.read(f"{f}.force") >= 0.9 * statics for f, statics in grip.force.items()):
+                break
+        twin.step(SETTLE_STEPS)
+        samples = []
+        for _ in range(round(0.5 / twin.dt)):  # half a second pressing, every step looked at
+            twin.step()
+            for f in grip.force:
+                assert twin.read(f"{f}.status") == stalled, f"{f} at step {twin.step_count - touched} after touching"
+            for inp in grip.close:
+                assert not twin.read(f"{inp}.moving")
+            samples.append({inp: twin.read(f"{inp}.actual") for inp in grip.close})
+        for inp in grip.close:
+            unit = twin.spec(f"{inp}.actual").unit
+            swing = max(s[inp] for s in samples) - min(s[inp] for s in samples)
+            assert swing <= (0.001 if unit == "rad" else 0.00005), f"{inp} swings {swing:g} {unit}"
+        for f, statics in grip.force.items():  # the drive's effort (N, or N m about a revolute lever's pivot)
+            assert twin.read(f"{f}.force") == pytest.approx(statics, rel=0.1), f
+            assert -closest(twin, f, grip.part) <= 0.0005  # at most 0.5 mm into the part at full effort
+
+
+@pytest.mark.parametrize("name", ["newcomer_2f_box", "parallel_200n", "light_5n"])
+def test_a_closing_centred_grip_hardly_pushes_the_part(name):
+    with Twin.from_station(GRIPPERS[name]) as twin:
+        part = GRIPS[name].part
+        start = twin.object_pose(part)[0]
+        close_on_part(twin, name)
+        twin.step(20)
+        assert math.dist(start[:2], twin.object_pose(part)[0][:2]) < 0.0005
+
+
+@pytest.mark.parametrize("name", ["newcomer_2f", "revolute_chuck", "light_5n"])
+def test_a_held_part_stays_put_relative_to_the_fingers_and_slip_stays_down(name):
+    with Twin.from_station(GRIPPERS[name]) as twin:
+        grip, _ = close_on_part(twin, name)
+        twin.step(SETTLE_STEPS)
+        finger = next(iter(grip.force))
+        link = twin.gripper.finger_links[finger][0]
+        c, body = twin.world.client, twin.world.machine
+
+        def relative():
+            tip = c.getLinkState(body, link)[0]
+            return [p - q for p, q in zip(twin.object_pose(grip.part)[0], tip)]
+
+        before = relative()
+        for _ in range(round(5.0 / twin.dt)):
+            twin.step()
+            assert not twin.read("slip")
+        assert math.dist(before, relative()) < 0.0002
+
+
+def test_a_resting_part_does_not_creep():
+    with Twin.from_station(GRIPPERS["newcomer_2f_box"]) as twin:
+        start = twin.object_pose("box")[0]
+        twin.write("finger_left", 0.035)  # the gripper moves (the cell is not at rest): the box lies on its table
+        twin.step(round(5.0 / twin.dt))
+        assert math.dist(start, twin.object_pose("box")[0]) < 0.0001
+
+
+def lift_by_robot(twin: Twin):
+    """MoveL 100 mm up at 0.2 m/s; per step (doGripped, slip, part z - TCP z)."""
+    twin.move("MoveL", "lift", 0.2)
+    trace = []
+    while twin.robot_busy:
+        twin.step()
+        trace.append((twin.read("doGripped"), twin.read("slip"), twin.read("can.z") - twin.tcp_pose().position[2]))
+    return trace
+
+
+def newcomer_with_effort(folder, effort: float) -> Twin:
+    """The newcomer's gripper on its can, both fingers' drives limited to `effort` (the station says so, as a user
+    would; grip_force stays the default 10 % of it)."""
+    src = GRIPPERS["newcomer_2f"]
+    text = (src / "station.toml").read_text()
+    text = text.replace('urdf = "newcomer_2f.urdf"', f'urdf = "{src / "newcomer_2f.urdf"}"')
+    text = text.replace('urdf = "../../../stations/robots/arm6700.urdf"',
+                        f'urdf = "{(src / "../../../stations/robots/arm6700.urdf").resolve()}"')
+    text = text.replace("\n[[targets]]", f"""
+[gripper.joints.finger_left]
+effort = {effort!r}
+[gripper.joints.finger_right]
+effort = {effort!r}
+
+[[targets]]""", 1)
+    (folder / "station.toml").write_text(text)
+    return Twin.from_station(folder)
+
+
+CAN_WEIGHT = math.pi * 0.015 ** 2 * 0.06 * 1000.0 * G  # the station's can: 30 mm x 60 mm of density 1000
+MU = 0.8 * 0.5  # the fingers' default friction times the can's
+
+
+def test_a_grip_with_three_times_the_weight_in_friction_lifts_the_light_can_within_a_millimetre(tmp_path):
+    with newcomer_with_effort(tmp_path, 3.0 * CAN_WEIGHT / (2 * MU)) as twin:  # mu x 2 x effort = 3 x weight
+        close_on_part(twin, "newcomer_2f")
+        twin.step(round(0.3 / twin.dt))
+        assert twin.read("doGripped")
+        trace = lift_by_robot(twin)
+        assert all(gripped and not slip for gripped, slip, _ in trace)
+        assert max(abs(dz - trace[0][2]) for _, _, dz in trace) < 0.001
+        assert twin.read("can.z") == pytest.approx(0.54, abs=0.001)
+
+
+def test_a_grip_under_seven_tenths_of_the_weight_in_friction_drops_the_can_with_slip_raised(tmp_path):
+    with newcomer_with_effort(tmp_path, 0.6 * CAN_WEIGHT / (2 * MU)) as twin:
+        close_on_part(twin, "newcomer_2f")
+        twin.step(round(0.3 / twin.dt))
+        assert twin.read("doGripped")  # it presses with its whole (weak) effort: it is friction that fails
+        trace = lift_by_robot(twin)
+        assert trace[-1][1]  # slip raised
+        assert twin.read("can.z") < 0.44 + 0.01  # the can stayed on the table
+
+
+def test_the_light_gantry_lifts_its_10_g_cube():
+    with Twin.from_station(GRIPPERS["light_5n"]) as twin:
+        close_on_part(twin, "light_5n")
+        twin.step(SETTLE_STEPS)
+        z0 = twin.object_pose("cube")[0][2] - twin.read("lift.actual")
+        twin.write("lift", 0.05)
+        twin.step(round(1.0 / twin.dt))
+        assert twin.read("lift.actual") == pytest.approx(0.05, abs=0.0005)
+        assert twin.object_pose("cube")[0][2] - twin.read("lift.actual") == pytest.approx(z0, abs=0.001)
+        assert twin.read("doGripped") and not twin.read("slip")
+
+
+@pytest.mark.parametrize("name, inp", [("newcomer_2f", "finger_left"), ("revolute_chuck", "jaw_1")])
+def test_an_actual_never_leaves_its_joints_range(name, inp):
+    with Twin.from_station(GRIPPERS[name]) as twin:
+        lo, hi = twin.spec(inp).min, twin.spec(inp).max
+        for end in (hi, lo):  # driven into each stop at full effort
+            twin.write(inp, end)
+            for _ in range(round(1.0 / twin.dt)):
+                twin.step()
+                assert lo <= twin.read(f"{inp}.actual") <= hi
+
+
+def test_inertias_that_do_not_fit_a_links_mass_and_size_are_replaced_with_one_warning_per_link(caplog):
+    from twin.core import world
+
+    world._warned.clear()
+    with caplog.at_level(logging.WARNING, logger="twin"):
+        twin = Twin.from_station(GRIPPERS["sloppy_inertia"])
+    with twin:
+        lines = [r.getMessage() for r in caplog.records]
+        for link in ("finger_1_link", "finger_2_link"):
+            assert len([line for line in lines if f"link {link}:" in line]) == 1
+            # the solid 12 x 25 x 70 mm box of 50 g its collision shape is (the URDF says 1 kg m^2)
+            m, x, y, z = 0.05, 0.012, 0.025, 0.07
+            box = (m / 12 * (y * y + z * z), m / 12 * (x * x + z * z), m / 12 * (x * x + y * y))
+            info = twin.world.client.getDynamicsInfo(twin.world.machine, twin.world.link_index[link])
+            assert info[2] == pytest.approx(box, rel=1e-6)
+        assert not any("base_link" in line for line in lines)  # the fixed root moves nothing: left alone
