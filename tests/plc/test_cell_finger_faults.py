@@ -53,7 +53,8 @@ def test_a_finger_jammed_open_is_named_and_no_grip_is_confirmed(tmp_path):
 
 
 def test_a_drive_lost_in_the_middle_of_a_grip_is_named_within_a_bounded_time(tmp_path):
-    dies_at = 1.9  # s: the first grip closes from 1.79 s on
+    dies_at = 2.1  # s: the first grip closes from 1.85 s on, at 20 mm/s: the dead finger stops 5 mm short of its
+    # open position, so the retry's preparation finds it lagging more than the PLC's 3 mm
     s, lines, text = run_with_faults(
         tmp_path, f'[faults.dead]\nkind = "finger_force_lost"\ninput = "L3"\neffort = 0.0\nat = {dies_at}\n')
     assert s.grips == 0 and "grip confirmed" not in text

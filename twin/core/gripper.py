@@ -63,6 +63,8 @@ RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its fo
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
 GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's drive effort
+LOST_WATCH_STEPS = 25  # a gripped part no finger presses on any more, and that no setpoint let go, is watched for
+# slip this many steps more (0.3 s at 12 ms): a dropped part leaves the fingers within a step
 RELEASE_SHARE = 0.25  # a grip lasts while every finger presses with this share of grip_force (no flicker)
 CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
 STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
@@ -175,6 +177,8 @@ class Gripper:
         self._constraint: int | None = None
         self._grip_reference: tuple | None = None  # the gripped part's pose in the base link's frame at the grip
         self._slip_part = ""
+        self._opened_since_grip = False  # a finger's setpoint was moved the opening way since the grip
+        self._lost_steps = 0  # steps since no finger pressed on the gripped part
         for inp in mechanism.inputs:
             client.resetJointState(body, self.joint[inp.name], self.setpoint[inp.name])
         for joint, master, mult, off in self.mimics:
@@ -223,7 +227,10 @@ class Gripper:
 
     def set_setpoint(self, name: str, value: float) -> None:
         """Validate and store a setpoint; it takes effect at the next step. Out of range: rejected."""
-        self.setpoint[name] = self.check(self.mechanism.input(name), value)
+        value = self.check(self.mechanism.input(name), value)
+        if (value - self.setpoint[name]) * self.closing.get(name, 0.0) < 0.0:
+            self._opened_since_grip = True
+        self.setpoint[name] = value
         self._new_goal.add(name)
 
     @property
@@ -552,6 +559,7 @@ class Gripper:
         if newly and newly != self.state.gripped:
             self._grip_reference = (newly, self._relative_pose(newly))
             self._slip_part, self.state.slip, self.state.slip_distance = newly, False, 0.0
+            self._opened_since_grip, self._lost_steps = False, 0
         self.state.gripped = newly
         self._watch_slip()
 
@@ -616,15 +624,21 @@ class Gripper:
         return c.multiplyTransforms(inv_pos, inv_orn, obj_pos, obj_orn)
 
     def _watch_slip(self) -> None:
-        """While a part is gripped, or still pressed by a finger after its grip was lost (it is sliding out): how
-        far it has moved relative to the base link since the grip; beyond slip_distance `slip` is raised, and it
-        stays raised until the next grip."""
+        """While a part is gripped, still pressed by a finger after its grip was lost (it is sliding out), or lost
+        without a setpoint that let it go (for LOST_WATCH_STEPS more): how far it has moved relative to the palm
+        since the grip; beyond slip_distance `slip` is raised, and it stays raised until the next grip."""
         if self._grip_reference is None:
             return
         name, (ref_pos, _) = self._grip_reference
         if self.state.gripped != name and not any(name in f.pressing for f in self.state.fingers.values()):
-            self._grip_reference = None  # let go (or fallen clear): nothing more to watch
-            return
+            # no finger presses on it any more: let go (a setpoint opened a finger since the grip), or lost; a lost
+            # part is watched a while longer, for it may leave the fingers within a step (a dropped part)
+            self._lost_steps += 1
+            if self._opened_since_grip or self._lost_steps > LOST_WATCH_STEPS:
+                self._grip_reference = None
+                return
+        else:
+            self._lost_steps = 0
         self.state.slip_distance = math.dist(self._relative_pose(name)[0], ref_pos)
         if self.state.slip_distance > self.spec.slip_distance:
             self.state.slip = True
