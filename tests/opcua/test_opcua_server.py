@@ -136,7 +136,8 @@ def test_engineering_units_and_ranges_follow_the_urdf_and_unece(lockstep):
 def test_every_signal_reads_as_over_modbus_at_the_same_lockstep_step(lockstep, rmap):
     with modbus(lockstep) as mb:
         assert not mb.write_registers(rmap["L2"].address, [31000, 31000, 31000], device_id=UNIT).isError()  # 310 mm
-        modbus_advance(mb, rmap, 60)  # mid-way: fingers moving, forces rising
+        modbus_advance(mb, rmap, 20)  # mid-way from 350 to 310 mm at 0.1 m/s: the fingers move (at 60 steps they
+        # stand on the ring at 320 mm, stalled: neither moving nor any longer flickering between moving and still)
         over_modbus = {e.name: modbus_read(mb, e) for e in rmap}
 
         async def main():
