@@ -90,10 +90,14 @@ def time_python(images, repeat: int) -> tuple[float, list]:
 
 
 def time_st(images, repeat: int) -> tuple[float, float, list]:
-    """(scan only, scan with the binding, the phases): the PLC's input images are encoded beforehand for the first."""
+    """(scan only, scan with the binding, the phases): the PLC's input images are encoded beforehand for the first.
+    The signals the grip sequence does not read (the robot's joints, the cell's counters, ...) stand still at
+    0, as a cell's image holds them all."""
     from plc_client.scan import InputImage
 
     logic = st_logic()
+    rest = {e.name: (False if e.type == "bool" else 0) for e in logic.binding.input_entries}
+    images = [(t, {**rest, **v}) for t, v in images]
     probe = logic.initial_state()
     encoded = []
     for t, v in images:
