@@ -61,7 +61,15 @@ def check_against_map(files: list[str], rmap: RegisterMap) -> int:
     except StError as exc:
         print(exc.headline(), file=sys.stderr)
         return 65
-    problems = located_problems(compiled.program, rmap)
+    from twin.modbus.register_map import MapError
+
+    try:
+        problems = located_problems(compiled.program, rmap)
+    except MapError as exc:
+        where = f" ({rmap.source})" if rmap.source else ""
+        print(f"plc: error: the register map{where} is not laid out for a Modbus master PLC: {exc}; take the PLC "
+              "layout (`twin map STATION --layout plc --format json`, or a server run with --layout plc)", file=sys.stderr)
+        return 2
     for line in problems:
         print(line, file=sys.stderr)
     return 65 if problems else 0

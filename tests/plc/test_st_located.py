@@ -60,7 +60,8 @@ def test_the_shipped_gripper_plc_and_its_declarations_check_against_the_station(
     # the default layout's map is another: the same declarations do not fit it
     json_map.write_text(subprocess.run([sys.executable, "-m", "twin", "map", str(CELL), "--format", "json"], cwd=ROOT,
                                        capture_output=True, text=True, check=True).stdout)
-    assert plc("check", str(CELL / "gripper.st"), str(CELL / "io.st"), "--map", str(json_map)).returncode != 0
+    out = plc("check", str(CELL / "gripper.st"), str(CELL / "io.st"), "--map", str(json_map))
+    assert out.returncode == 2 and "not laid out for a Modbus master PLC" in out.stderr and "--layout plc" in out.stderr
 
 
 def test_the_st_gripper_plc_grips_the_ring_over_modbus_in_lockstep():
