@@ -237,11 +237,6 @@ def _replace(s1, s2, n, p):
     return s1[:p - 1] + s2 + s1[p - 1 + max(0, n):]
 
 
-def _ns_to_ms(t):
-    q = abs(t) // 1_000_000
-    return q if t >= 0 else -q
-
-
 def _str_to_int(s):
     try:
         return int(s.strip().replace("_", ""), 0) if s.strip()[:2].lower() in ("0x",) else int(float(s.strip()))

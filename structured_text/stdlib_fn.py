@@ -3,8 +3,10 @@
 `signature(NAME, arg_types) -> result type` (or a message why the arguments do not fit) is used by
 the checker; `generate(NAME, codes, arg_types, result)` by the compiler. One table, both stages.
 Conversions `A_TO_B` (and `TO_B`): REAL to an integer rounds to the nearest, halves to even (as
-matiec's and the standard's examples do), TRUNC cuts toward zero; integer to integer wraps; TIME
-to an integer is milliseconds (and back); numbers to STRING print as ST literals would.
+matiec's and the standard's examples do), TRUNC cuts toward zero; integer to integer wraps; TIME (DATE,
+TOD, DT) to and from numbers counts seconds, as matiec's library does (the standard leaves the unit to the
+implementation): TIME_TO_DINT(T#1500ms) = 1, TIME_TO_REAL(T#1500ms) = 1.5, DINT_TO_TIME(2) = T#2s;
+numbers to STRING print as ST literals would.
 """
 from __future__ import annotations
 
@@ -345,7 +347,7 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
         elif sk == "bool":
             return f"int({code})"
         elif sk in _DT_KINDS:
-            inner = f"_ns_to_ms({code})"
+            inner = f"(({code}) // 1000000000)"  # whole seconds (matiec's tv_sec)
         elif sk == "string":
             inner = f"_str_to_int({code})"
         else:
@@ -358,7 +360,7 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
         if sk == "string":
             inner = f"float({code})"
         elif sk in _DT_KINDS:
-            inner = f"({code} / 1000000)"
+            inner = f"({code} / 1e9)"  # seconds
         else:
             inner = f"float({code})"
         return f"_up(_pk({inner}))[0]" if dst.bits == 32 else inner
@@ -370,8 +372,8 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
         if sk in _DT_KINDS:
             return code
         if sk == "real":
-            return f"_round({code} * 1000000)"
-        return f"({code} * 1000000)"
+            return f"_round({code} * 1e9)"  # seconds
+        return f"({code} * 1000000000)"
     if dk == "string":
         if sk == "string":
             return code

@@ -339,3 +339,18 @@ END_PROGRAM
     plc.set("e", True)
     plc.scan_ns(10 * MS)
     assert (plc.get("y"), plc.get("ok")) == (10, True)
+
+
+def test_time_converts_to_and_from_numbers_in_seconds(tmp_path):
+    # the unit is the implementation's (IEC 61131-3); seconds, as matiec/OpenPLC's library
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR d : DINT; r : REAL; t1, t2 : TIME; END_VAR
+d := TIME_TO_DINT(T#1500ms);
+r := TIME_TO_REAL(T#1500ms);
+t1 := DINT_TO_TIME(2);
+t2 := REAL_TO_TIME(0.25);
+END_PROGRAM
+""")
+    plc.scan_ns(0)
+    assert (plc.get("d"), plc.get("r"), plc.get("t1"), plc.get("t2")) == (1, 1.5, 2000 * MS, 250 * MS)
