@@ -192,6 +192,12 @@ class Trajectory:
         s, v = self.profile.s(t)
         return self._at(s)[1] * v
 
+    def state(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(q, qd) at time t, the profile and the knots looked up once (for every physics substep)."""
+        s, v = self.profile.s(t)
+        q, dq = self._at(s)
+        return q, dq * v
+
     def done(self, t: float) -> bool:
         return t >= self.duration
 

@@ -153,6 +153,22 @@ class MotionQueue:
                 out += s.traj.qd(t - s.start)
         return out
 
+    def state(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(q, qd) at t: what the robot commands at every physics substep."""
+        segments = self.segments
+        if len(segments) == 1:  # (the common case: one motion, no blend)
+            s = segments[0]
+            q, qd = s.traj.state(t - s.start)
+            return self.q_base + (q - s.q0), (qd if s.start < t < s.end else qd * 0.0)
+        q, qd = self.q_base.copy(), np.zeros_like(self.q_base)
+        for s in segments:
+            if t > s.start:
+                qs, qds = s.traj.state(t - s.start)
+                q += qs - s.q0
+                if t < s.end:
+                    qd += qds
+        return q, qd
+
     # -- corners ------------------------------------------------------------------------------------
     def _corner(self, prev: Segment, nxt: Trajectory, now: float) -> float | None:
         """When `nxt` starts to blend out of `prev`'s zone, or None when the TCP is already past the zone's edge

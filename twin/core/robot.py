@@ -262,7 +262,7 @@ class Robot:
                 self._hold, self._hold_for = queue.q(queue.end), traj
             self._command_hold(self._hold)
         else:
-            self._command(queue.q(tau), queue.qd(tau))
+            self._command(*queue.state(tau))
 
     def _command_hold(self, q: np.ndarray) -> None:
         """Hold q: commanded once (the motors keep their command), not again at every substep."""
