@@ -180,6 +180,22 @@ def test_a_master_reading_in_three_requests_sees_one_step_while_the_twin_steps_b
             c.close()
 
 
+def test_a_client_that_waits_for_steps_reads_the_new_step(cell_server):
+    """A lockstep script polls sim.advance until its steps are done: its next reads are of the step they led to,
+    even if it (or its heartbeat) read something of an earlier step just before."""
+    rmap = build_map(CELL, "plc")
+    script, stepper = _client(cell_server.port), _client(cell_server.port)
+    try:
+        before = rmap["sim.step"].decode(script.read_input_registers(0, count=2).registers)  # holds this step
+        _advance(stepper, rmap, 3)  # someone else steps
+        script.read_holding_registers(rmap["sim.advance"].address, count=1)  # the script sees the steps done
+        ir = script.read_input_registers(2, count=2).registers  # sim.time_ms: not read before, of the new step
+        assert rmap["sim.time_ms"].decode(ir) == round((before + 3) * 12)  # 12 ms steps
+    finally:
+        script.close()
+        stepper.close()
+
+
 def test_reads_of_every_configured_range_never_get_an_exception(cell_server):
     cfg = mbconfig(CELL)
     c = _client(cell_server.port)

@@ -9,8 +9,8 @@ A consistent input image (`PollHold`): a master that reads its inputs in several
 inputs, then input registers, then holding registers, the twin stepping in between) gets them all from the
 step of its first read. Each connection keeps the outputs' images (discrete inputs, input registers) of its
 first read; later reads on that connection are answered from them until one reads an address it already
-read (the next poll), asks for steps (writes `sim.advance`), or reads nothing for `POLL_HOLD` seconds (`twin
-serve --poll-hold`). Coils and holding registers are what was written, as always.
+read (the next poll), asks for steps or waits for them (writes or reads `sim.advance`), or reads nothing for
+`POLL_HOLD` seconds (`twin serve --poll-hold`). Coils and holding registers are what was written, as always.
 """
 from __future__ import annotations
 
@@ -306,6 +306,9 @@ class PduHandler:
         data = self.registers(HOLDING_REGISTER if pdu[0] == 3 else INPUT_REGISTER, address, count)
         if isinstance(data, int):
             return data
+        adv = self.map.by_name.get(ADVANCE)
+        if self.hold is not None and pdu[0] == 3 and adv is not None and address <= adv.address < address + count:
+            self.hold.release()  # a client reading sim.advance waits for steps: its next reads are of the new step
         return bytes((pdu[0], len(data))) + data
 
     def registers(self, table: str, address: int, count: int):
