@@ -58,6 +58,7 @@ from pathlib import Path
 from typing import Protocol
 
 from rapid_like.station_host import attach_controller
+from twin.core.device import ObservingDevice
 from twin.core.errors import StationError, TwinError
 from twin.core.signal_table import SIM_MAP_CRC, SIM_NAMES, WATCHDOG_MS, station_signals
 from twin.core.station import Station, load_station
@@ -68,6 +69,21 @@ from twin.modbus.log import announce as _announce, log as _log
 from twin.modbus.register_map import RegisterMap, build_register_map
 from twin.pacing import LockstepRunner, RealtimeRunner
 from twin.watchdog import Watchdog
+
+
+class _ControllerState(ObservingDevice):
+    """Tells the event stream when the robot controller's state changes (running, stopped, completed, error;
+    a program waiting for a signal or a motion is running), after the step in which it did."""
+
+    def __init__(self, controller, events: Events):
+        self.controller, self.events, self.state = controller, events, None
+
+    def after_step(self, twin) -> None:
+        state = self.controller.state
+        state = "running" if state == "waiting" else state
+        if state != self.state:
+            self.state = state
+            self.events.emit(CONTROLLER, type="state", state=state)
 
 
 class FrontEnd(Protocol):
@@ -125,6 +141,8 @@ class Cell:
             self.watchdog.on_event = self.events.emit
             if self.station.controller is not None:
                 self.controller = attach_controller(self.twin, on_event=self._controller_event(on_event), entry=entry)
+                if self.events.enabled:
+                    self.twin.add_device(_ControllerState(self.controller, self.events))
             self.exchange = Exchange(self.twin, log=log, constants={
                 SIM_MAP_CRC: self.register_map.crc, WATCHDOG_MS: round((self.watchdog.timeout or 0) * 1000)})
             self.exchange.on_fault = lambda message: self.events.emit(FAULT, message=message)

@@ -63,7 +63,10 @@ def test_a_harness_learns_the_port_the_clients_the_robots_words_the_comm_loss_an
     assert prints[1][0] - prints[0][0] == pytest.approx(0.06, abs=1e-9)
     errlog = next(e for e in said if e["type"] == "errlog")
     assert (errlog["level"], errlog["header"], errlog["reason"], errlog["t"]) == ("warning", "Heads up", "a reason", prints[1][0])
-    assert said[-1]["type"] == "end" and said[-1]["reason"] == "completed"
+    ends = [e for e in said if e["type"] in ("end", "error")]
+    assert len(ends) == 1 and ends[0]["reason"] == "completed" and ends[0]["t"] == prints[1][0]
+    states = [e["state"] for e in said if e["type"] == "state"]
+    assert states == ["running", "completed"]  # its state changes, after the steps they happened in
     # armed by the first sim.advance at t = 0, the watchdog fires at the first step at or after 0.1 s: 9 x 12 ms
     assert lost["t"] == pytest.approx(0.108) and lost["silent_s"] == pytest.approx(0.108) and lost["timeout_s"] == 0.1
     assert back["source"] == f"modbus {me}" and back["t"] == pytest.approx(0.24)
