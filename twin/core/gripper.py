@@ -535,7 +535,10 @@ class Gripper:
             pressed = pressing.get(finger)
             on = {t: pressed[t] for t in self.targets if pressed.get(t, 0.0) > 0.0} if pressed else {}
             # friction mode: no contact without a normal force, so a finger pressing on nothing needs no query
-            touching = self._touching(finger, CONTACT_SLACK) if on else () if friction else self._touching(finger)
+            if on and friction and all(f >= self._release_force[finger] for f in on.values()):
+                touching = tuple(on)  # pressing with a quarter of its grip force or more: touching, no query needed
+            else:
+                touching = self._touching(finger, CONTACT_SLACK) if on else () if friction else self._touching(finger)
             contacts = tuple(t for t in touching if not friction or t in on)
             force = sum(on.values())
             fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
