@@ -13,16 +13,44 @@ the simulation (so a step and a request never interleave: a read sees a complete
   still to run. The simulation never moves on its own, so a scripted client gets the same results,
   bit for bit, run after run.
 
+Real-time scheduling (`RealtimeRunner(..., priority=True)`, what `twin serve --realtime` asks for): while it
+runs, the runner's thread asks the operating system for SCHED_RR at the lowest real-time priority, as soft-PLC
+runtimes do, so a busy machine's ordinary processes cannot push its steps late; processes it starts afterwards
+do not inherit it (SCHED_RESET_ON_FORK). It always sleeps at least `MIN_SLEEP` of a period between steps, so a
+late simulation catching up cannot starve the machine. Where the OS does not allow it (no CAP_SYS_NICE, no
+RLIMIT_RTPRIO, not Linux) the runner quietly runs as before; it puts the old policy back when it stops. Never
+in lockstep, nor in a campaign's workers (they step cells in process and run no runner).
+
 `step` is a callable that runs one simulation step and returns False when the simulation cannot go on
 (a fault): the runner then stops stepping.
 """
 from __future__ import annotations
 
 import asyncio
+import os
 import time
 from collections.abc import Callable
 
 Step = Callable[[], bool]
+MIN_SLEEP = 0.1  # share of a period slept between steps under real-time scheduling
+
+
+def ask_realtime_scheduling() -> Callable[[], None] | None:
+    """SCHED_RR at the lowest real-time priority for this thread, not inherited by processes it starts.
+    Returns what puts the old policy back, or None when the OS does not allow it (nothing changed)."""
+    try:
+        policy, param = os.sched_getscheduler(0), os.sched_getparam(0)
+        rr = os.SCHED_RR
+        os.sched_setscheduler(0, rr | os.SCHED_RESET_ON_FORK, os.sched_param(os.sched_get_priority_min(rr)))
+    except (AttributeError, OSError):
+        return None
+
+    def restore() -> None:
+        try:
+            os.sched_setscheduler(0, policy, param)
+        except OSError:
+            pass
+    return restore
 
 
 class RealtimeRunner:
@@ -31,9 +59,12 @@ class RealtimeRunner:
     mode = "realtime"
 
     def __init__(self, step: Step, dt: float, speed: float = 1.0, *, max_lag: float = 0.5,
-                 clock: Callable[[], float] = time.perf_counter):
+                 clock: Callable[[], float] = time.perf_counter, priority: bool = False):
+        """`priority`: ask for real-time scheduling while running (see the module docstring); `scheduled`
+        tells whether the OS granted it."""
         if not dt > 0 or not speed > 0:
             raise ValueError("dt and speed must be positive")
+        self.priority, self.scheduled = priority, False
         self.step, self.dt, self.speed, self.max_lag, self.clock = step, dt, speed, max_lag, clock
         self.period = dt / speed
         self.steps = 0
@@ -69,7 +100,17 @@ class RealtimeRunner:
                 self.steps += 1
 
     async def run(self) -> None:
-        clock, period = self.clock, self.period
+        restore = ask_realtime_scheduling() if self.priority else None
+        self.scheduled = restore is not None
+        try:
+            await self._run(period=self.period, least=self.period * MIN_SLEEP if restore is not None else 0.0)
+        finally:
+            if restore is not None:
+                restore()
+            self.scheduled = False
+
+    async def _run(self, period: float, least: float) -> None:
+        clock = self.clock
         self._resumed = asyncio.Event()
         t0 = clock()
         k = 0  # steps run since t0
@@ -80,8 +121,9 @@ class RealtimeRunner:
                 t0, k = clock(), 0  # the schedule starts again from now
                 continue
             delay = t0 + k * period - clock()
-            # Sleep until the step's start; never run two steps without letting the server answer.
-            await asyncio.sleep(delay if delay > 0 else 0)
+            # Sleep until the step's start; never run two steps without letting the server answer (nor,
+            # under real-time scheduling, without letting the machine run: at least `least`).
+            await asyncio.sleep(delay if delay > least else least)
             if self._stop:
                 break
             if self.paused:

@@ -214,19 +214,22 @@ class Cell:
     def add_front_end(self, front: FrontEnd) -> None:
         self.front_ends.append(front)
 
-    def pace(self, *, lockstep: bool = False, speed: float = 1.0):
-        """Make the runner (it does not run yet): lockstep, or `speed` x real time."""
+    def pace(self, *, lockstep: bool = False, speed: float = 1.0, priority: bool = False):
+        """Make the runner (it does not run yet): lockstep, or `speed` x real time (`priority`: with real-time
+        scheduling where the OS allows it, see `twin.pacing`)."""
         self.publishing = True  # front ends read every step's snapshot
-        self.runner = LockstepRunner(self.exchange.step) if lockstep else RealtimeRunner(self.exchange.step, self.dt, speed)
+        self.runner = (LockstepRunner(self.exchange.step) if lockstep
+                       else RealtimeRunner(self.exchange.step, self.dt, speed, priority=priority))
         self.exchange.runner = self.runner
         self.exchange.publish()
         return self.runner
 
     async def serve(self, *, lockstep: bool = False, speed: float = 1.0, paused: bool = False,
-                    stop: asyncio.Event | None = None) -> int:
+                    stop: asyncio.Event | None = None, priority: bool = False) -> int:
         """Start the front ends and run until `stop` is set (or SIGINT/SIGTERM). Returns the exit code
         (2 when a front end cannot start). A simulation fault keeps the front ends serving the last state.
-        `paused` (real time): the runner waits for `runner.resume()` (the view's Run button)."""
+        `paused` (real time): the runner waits for `runner.resume()` (the view's Run button). `priority` (real
+        time; `twin serve`): real-time scheduling for the simulation's thread where the OS allows it."""
         loop = asyncio.get_running_loop()
         loop.set_exception_handler(lambda _loop, ctx: self.log(f"event loop: {ctx.get('message')}: "
                                                                f"{ctx.get('exception')!r}", logging.DEBUG))
@@ -236,7 +239,7 @@ class Cell:
                 loop.add_signal_handler(sig, stop.set)
             except (NotImplementedError, RuntimeError, ValueError):  # not the main thread, or Windows
                 pass
-        runner = self.pace(lockstep=lockstep, speed=speed)
+        runner = self.pace(lockstep=lockstep, speed=speed, priority=priority and not lockstep)
         if not lockstep:
             self.watchdog.clock = runner.clock  # real time: the wall clock; lockstep: simulated time
             if paused:

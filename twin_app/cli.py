@@ -264,7 +264,7 @@ def cmd_serve(args) -> int:
             cell.add_front_end(front)
         if signals.received is not None:
             raise StopRequested(signals.received)
-        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, stop=stop))
+        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, stop=stop, priority=True))
     except BaseException:
         if signals.received is None:
             raise

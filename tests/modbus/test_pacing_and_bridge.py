@@ -159,3 +159,50 @@ def test_a_write_reads_back_at_once_and_no_publish_undoes_it_before_it_is_applie
     assert exchange.step()
     assert twin.values["target"] == 0.05 and holding(target) == 5000
     assert struct.unpack_from(">H", bridge.images.input_registers, 2 * x.address)[0] == 5000
+
+
+def _rr_allowed() -> bool:
+    """Whether this machine lets a process take SCHED_RR (asked of a separate process, not the runner's code)."""
+    import subprocess
+    import sys
+
+    probe = "import os; os.sched_setscheduler(0, os.SCHED_RR, os.sched_param(1))"
+    return subprocess.run([sys.executable, "-c", probe], capture_output=True).returncode == 0
+
+
+def test_real_time_scheduling_only_while_a_realtime_runner_runs_and_not_for_the_processes_it_starts():
+    import os
+    import subprocess
+    import sys
+
+    if not hasattr(os, "sched_getscheduler"):
+        import pytest
+        pytest.skip("no POSIX scheduling on this OS")
+    flag = getattr(os, "SCHED_RESET_ON_FORK", 0)
+    before = os.sched_getscheduler(0) & ~flag
+    seen, child = [], []
+
+    def step():
+        seen.append(os.sched_getscheduler(0) & ~flag)
+        if not child:  # a process started by the simulation's thread runs as an ordinary process
+            child.append(int(subprocess.run([sys.executable, "-c", "import os; print(os.sched_getscheduler(0))"],
+                                            capture_output=True, text=True).stdout))
+        return len(seen) < 3
+
+    asyncio.run(RealtimeRunner(step, 0.001, priority=True).run())
+    assert seen == [os.SCHED_RR if _rr_allowed() else before] * 3  # granted, or quietly as before
+    assert child == [os.SCHED_OTHER]
+    assert os.sched_getscheduler(0) & ~flag == before  # put back when it stops
+    seen.clear()
+    runner = LockstepRunner(step)  # lockstep: never real-time scheduling
+    runner.request(3)
+    asyncio.run(_lockstep(runner))
+    assert seen and set(seen) == {before}
+
+
+async def _lockstep(runner) -> None:
+    task = asyncio.ensure_future(runner.run())
+    while runner.remaining > 0 and not runner.failed:
+        await asyncio.sleep(0.001)
+    runner.stop()
+    await task
