@@ -408,7 +408,8 @@ class Compiler:
         if k == "real":
             if vt.kind == "real" and (fits and (vt.bits <= tt.bits) or vt is ty.LIT_REAL and tt.bits == 64):
                 return code
-            if tt.bits == 32:
+            if tt.bits == 32 and not (vt.kind in ("int", "bits") and fits and vt is not ty.LIT_INT
+                                      and getattr(vt, "bits", 64) <= 24):
                 return f32(code)
             return code if vt.kind == "real" else f"float({code})"
         if k == "string":

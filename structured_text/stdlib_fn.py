@@ -363,6 +363,8 @@ def convert(code: str, src: ty.DataType, dst: ty.DataType, truncate: bool = Fals
             inner = f"({code} / 1e9)"  # seconds
         else:
             inner = f"float({code})"
+            if sk in ("int", "bits", "bool") and src is not ty.LIT_INT and getattr(src, "bits", 64) <= 24:
+                return inner  # a REAL holds every value of a 24-bit integer exactly
         return f"_up(_pk({inner}))[0]" if dst.bits == 32 else inner
     if dk in _DT_KINDS:
         if sk == "dt" and dk == "tod":
