@@ -13,6 +13,8 @@ inputs at the same times give the same run, bit for bit.
 
 Process images follow OpenPLC's layout: one table per area and size, `%IX100.0` (byte 100, bit 0),
 `%IW100` (word 100), `%QD2`, ... A word address is not a byte offset, so %IW0 and %IX0.0 do not overlap.
+The images are dicts keyed by the address's canonical text (`address_key`: '%IX100.0'), so a fieldbus
+binding may write `plc.inputs` directly; `plc.located()` lists what the program locates.
 
 A run-time error puts the PLC in STOP: `scan` raises PlcFault (FILE:LINE:COL, the task and program
 instance) and every later scan raises it again until `cold_restart()` or `warm_restart()`.
