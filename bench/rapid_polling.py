@@ -1,11 +1,15 @@
 """Wall time per simulated second of RAPID polling loops offline, side by side in one run; and the ring rig's
 robot cycle in the physics cell with the motion planner, each motion's time now and under the old model.
 
-    python -m bench rapid [--seconds S] [--no-cycle]
+    python -m bench rapid [--seconds S] [--no-cycle] [--no-planning]
 
 Programs: an idle time-less loop (`WHILE diGo = 0 DO ENDWHILE`), a busy one that changes data
 every turn (`Incr n`), a `WaitUntil` (polls every 0.1 s), a loop with `WaitTime 0.01` and an ITimer
 TRAP every 0.01 s. diGo is set at the end, so every loop runs for the whole S simulated seconds.
+
+Planning cost: the wall time `twin.move` takes to plan a motion (IK along the path, its timing, its corner)
+inside one simulation step, and the worst step's wall time, for the ring rig's cycle and a z50 square of MoveL,
+with a path's IK samples solved all at once (motion.BATCH_IK) and one by one.
 """
 from __future__ import annotations
 
@@ -34,6 +38,7 @@ def main(argv: list[str]) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench rapid", description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=5.0, help="simulated seconds per program (default 5)")
     ap.add_argument("--no-cycle", action="store_true", help="skip the ring rig's cycle in the physics cell")
+    ap.add_argument("--no-planning", action="store_true", help="skip the planning cost (two cycles, two programs)")
     args = ap.parse_args(argv)
     print(f"{'program':<22} {'simulated s':>11} {'wall s':>8} {'wall s per simulated s':>23}")
     for name, body in LOOPS.items():
@@ -44,6 +49,8 @@ def main(argv: list[str]) -> int:
         print(f"{name:<22} {out.t:>11.2f} {wall:>8.3f} {wall / max(out.t, 1e-9):>23.4f}")
     if not args.no_cycle:
         ring_rig_cycle()
+    if not args.no_planning:
+        planning_cost()
     return 0
 
 
@@ -71,6 +78,88 @@ def old_duration(traj) -> float:
     if ramp > cruise:
         ramp = cruise = max(math.sqrt(need), min(OLD_RAMP, cruise))
     return cruise + ramp
+
+
+def _timed_cycle(station, entry: str) -> tuple[float, list[float], list[float], list]:
+    """Run `entry` in the physics cell of `station` to its end: (simulated cycle s, wall s of every step, wall s
+    of planning every motion (twin.move: IK along the path, timing, the corner), the motions' trajectories)."""
+    from twin_app.cell import open_cell
+
+    steps, planning, seen = [], [], []
+    with open_cell(station, entry=entry) as cell:
+        twin = cell.twin
+        move = twin.move
+
+        def timed_move(*args, **kwargs):
+            t0 = time.perf_counter()
+            try:
+                return move(*args, **kwargs)
+            finally:
+                planning.append(time.perf_counter() - t0)
+
+        twin.move = timed_move
+        while cell.controller.state not in ("completed", "error"):
+            t0 = time.perf_counter()
+            cell.step()
+            steps.append(time.perf_counter() - t0)
+            traj = twin.robot.trajectory
+            if traj is not None and (not seen or seen[-1] is not traj):
+                seen.append(traj)
+        assert cell.controller.state == "completed", cell.controller.error
+        return cell.time, steps, planning, seen
+
+
+SQUARE = """MODULE Square
+  PERS tooldata tG := [TRUE,[[0,0,350],[1,0,0,0]],[20,[0,0,150],[1,0,0,0],0,0,0]];
+  CONST robtarget p0 := [[1500,-300,900],[0,1,0,0],[-1,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]];
+  PROC main()
+    MoveJ p0, v1000, fine, tG;
+    MoveL Offs(p0,400,0,0), v500, z50, tG;
+    MoveL Offs(p0,400,600,0), v500, z50, tG;
+    MoveL Offs(p0,0,600,0), v500, z50, tG;
+    MoveL p0, v500, fine, tG;
+  ENDPROC
+ENDMODULE
+"""
+
+
+def planning_cost() -> None:
+    """Wall time of planning a motion (inside one simulation step) and the worst step, the ring rig's cycle and a
+    z50 square of MoveL, with the path's samples solved at once (now) and one by one (the old solve)."""
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    from twin.core import motion
+
+    stations = Path(__file__).resolve().parent.parent / "stations"
+    with tempfile.TemporaryDirectory() as tmp:
+        shutil.copytree(stations / "ring_rig", Path(tmp) / "rig")
+        shutil.copytree(stations / "robots", Path(tmp) / "robots")
+        toml = Path(tmp) / "rig" / "station.toml"
+        toml.write_text(toml.read_text().replace('program = "ring_rig.mod"', 'program = "square.mod"'))
+        (Path(tmp) / "rig" / "square.mod").write_text(SQUARE)
+        runs = [("ring rig cycle", stations / "ring_rig", "Path_FullAutoRun"), ("z50 square", Path(tmp) / "rig", "main")]
+        print(f"\n{'planning (wall, inside one step)':<34} {'IK':<14} {'motions':>7} {'mean ms':>8} {'max ms':>8} "
+              f"{'worst step ms':>14} {'steps > 12 ms':>13}")
+        results = {}
+        for label, station, entry in runs:
+            for batch in (False, True):
+                motion.BATCH_IK = batch
+                try:
+                    cycle, steps, planning, seen = _timed_cycle(station, entry)
+                finally:
+                    motion.BATCH_IK = True
+                results[label, batch] = (cycle, [t.duration for t in seen])
+                late = sum(1 for s in steps if s > 0.012)
+                print(f"{label:<34} {'all at once' if batch else 'one by one':<14} {len(planning):>7} "
+                      f"{1000 * sum(planning) / len(planning):>8.2f} {1000 * max(planning):>8.2f} "
+                      f"{1000 * max(steps):>14.2f} {late:>13}")
+        for label, _, _ in runs:
+            (c0, d0), (c1, d1) = results[label, False], results[label, True]
+            diff = max((abs(a - b) for a, b in zip(d0, d1)), default=0.0)
+            print(f"{label}: cycle {c0:.3f} s one by one, {c1:.3f} s all at once; motions' durations differ by at "
+                  f"most {diff * 1000:.3f} ms")
 
 
 def ring_rig_cycle() -> None:

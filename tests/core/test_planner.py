@@ -84,3 +84,60 @@ def test_blended_motions_replay_bit_for_bit(tmp_path):
             run(twin)
             runs.append(np.concatenate([twin.robot.q, twin.robot.qd, [twin.time]]))
     assert np.array_equal(runs[0], runs[1])
+
+
+def test_the_arm_in_numpy_is_the_arm_pybullet_computes_with_a_prismatic_axis_and_a_tilted_base(tmp_path):
+    """fk_many (the planner's product of exponentials) against pybullet's own forward kinematics, on an arm whose
+    first axis is a lift (prismatic, tilted off z) and whose base and tool are turned."""
+    from twin.core.kinematics import ArmKinematics
+    from twin.core.geometry import quat_matrix
+
+    text = ARM.read_text().replace('<joint name="joint_1" type="revolute">', '<joint name="joint_1" type="prismatic">')
+    text = text.replace('<origin xyz="0 0 0.3" rpy="0 0 0"/><axis xyz="0 0 1"/>',
+                        '<origin xyz="0 0 0.3" rpy="0 0 0"/><axis xyz="0.6 0 0.8"/>', 1)
+    lift = tmp_path / "lift_arm.urdf"
+    lift.write_text(text)
+    odd = tmp_path / "odd_axis_arm.urdf"  # an axis not of unit length: pybullet's reading of it is the arm
+    odd.write_text(text.replace('<axis xyz="0.6 0 0.8"/>', '<axis xyz="0.3 0 1"/>'))
+    for urdf in (ARM, lift, odd):
+        kin = ArmKinematics(urdf, (0.2, -0.1, 0.4), Pose.from_xyz_rpy((0, 0, 0), (0.1, -0.2, 0.7)).orientation,
+                            tool=Pose.from_xyz_rpy((0.01, 0.02, 0.3), (0.3, 0.0, -0.5)))
+        try:
+            qs = np.random.default_rng(7).uniform(kin.lower, kin.upper, (40, 6))
+            positions, rotations = kin.fk_many(qs)
+            for q, p, r in zip(qs, positions, rotations):
+                pose = kin.fk(q)
+                assert np.allclose(p, pose.position, atol=1e-6)
+                assert np.allclose(r, quat_matrix(pose.orientation), atol=1e-6)
+        finally:
+            kin.close()
+
+
+def test_a_paths_samples_solved_at_once_are_the_path_solved_one_by_one(twin, monkeypatch):
+    """The batch IK along a MoveL and a MoveC against the sample-by-sample solve (pybullet's IK seeded from the
+    previous sample), and every knot's TCP on the programmed line / circle."""
+    from twin.core import motion
+
+    kin = twin.kinematics
+    q0 = twin.robot_q
+    start = kin.fk(q0)
+    line_end = down(1.7, 0.4, 0.5)
+    via, arc_end = down(1.6, -0.3, 0.9), down(1.2, 0.3, 0.9)
+    plans = {}
+    for batch in (True, False):
+        monkeypatch.setattr(motion, "BATCH_IK", batch)
+        plans[batch] = (motion.movel(kin, q0, line_end, Speed(v_tcp=0.5)),
+                        motion.movec(kin, q0, via, arc_end, Speed(v_tcp=0.5)))
+    for fast, slow in zip(plans[True], plans[False]):
+        assert np.array_equal(fast._s, slow._s)
+        assert np.abs(fast._knots - slow._knots).max() < 2e-3  # rad: both within the IK's 0.1 mm
+        assert fast.duration == pytest.approx(slow.duration, abs=1e-3)
+    line = plans[True][0]
+    a, b = start.position, line_end.position
+    for s, q in zip(line._s, line._knots):
+        assert np.linalg.norm(kin.fk(q).position - (a + s * (b - a))) < 1e-4
+    arc = plans[True][1]
+    centre = motion.circle_through(start.position, via.position, arc_end.position, "arc")[0]
+    radius = np.linalg.norm(start.position - centre)
+    for q in arc._knots:
+        assert abs(np.linalg.norm(kin.fk(q).position - centre) - radius) < 1e-4

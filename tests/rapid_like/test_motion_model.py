@@ -105,10 +105,9 @@ def test_the_same_square_with_fine_stops_within_half_a_millimetre_of_each_corner
     _, t, p = run_in_cell(tmp_path, square("fine"))
     v = speeds(t, p)
     for corner in CORNERS:
-        d = np.linalg.norm(p - corner, axis=1)
-        i = int(np.argmin(d))
-        assert d[i] < 0.0005
-        assert v[i] < 0.01  # at rest there
+        near = np.linalg.norm(p - corner, axis=1) < 0.0005
+        # at rest there (the closest sample may be the one that arrives, a few um before it settles)
+        assert near.any() and v[near].min() < 0.01
 
 
 def test_zones_shorten_the_cycle(tmp_path):

@@ -47,6 +47,38 @@ def quat_matrix(q: np.ndarray) -> np.ndarray:
                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
+def quat_matrices(qs: np.ndarray) -> np.ndarray:
+    """`quat_matrix` of many unit quaternions (N, 4) at once: (N, 3, 3)."""
+    x, y, z, w = (qs[:, i] for i in range(4))
+    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
+                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
+                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+
+
+def slerp_many(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """`slerp` at many parameters s (N,) at once: (N, 4)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    s = np.asarray(s, dtype=float)[:, None]
+    d = float(np.dot(a, b))
+    if d < 0.0:
+        b, d = -b, -d
+    if d > 0.9995:
+        out = a + s * (b - a)
+        return out / np.linalg.norm(out, axis=1, keepdims=True)
+    theta = math.acos(d)
+    sin_t = math.sin(theta)
+    return (np.sin((1.0 - s) * theta) / sin_t) * a + (np.sin(s * theta) / sin_t) * b
+
+
+def rotation_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The rotation angles (rad, 0 to pi) between rotation matrices a and b ((N, 3, 3) each, or one of them (3, 3))."""
+    rel = np.swapaxes(a, -1, -2) @ b
+    vee = np.stack([rel[..., 2, 1] - rel[..., 1, 2], rel[..., 0, 2] - rel[..., 2, 0], rel[..., 1, 0] - rel[..., 0, 1]],
+                   axis=-1)
+    return np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), (np.trace(rel, axis1=-2, axis2=-1) - 1.0) / 2.0)
+
+
 def quat_from_rpy(rpy: Iterable[float]) -> np.ndarray:
     """Quaternion of roll-pitch-yaw in rad, as pybullet's getQuaternionFromEuler."""
     r, p, y = (float(v) for v in rpy)

@@ -22,7 +22,7 @@ import numpy as np
 from .bullet import BulletClient, pybullet
 
 from .errors import MotionError
-from .geometry import Pose, quat_conj, quat_mul
+from .geometry import Pose, quat_conj, quat_matrix, quat_mul, quat_rotate
 from .native_output import quiet_native_output
 from .defaults import ARM_JOINTS
 
@@ -123,6 +123,116 @@ class ArmKinematics:
         # calculateJacobian takes a point in the link's centre-of-mass frame: the flange frame's origin there
         ls = c.getLinkState(self.body, self.flange)
         self._flange_origin_in_com = Pose(ls[2], ls[3]).inverse().position.tolist()
+        self._screws()
+
+    def _screws(self) -> None:
+        """The arm as a product of exponentials (read off pybullet at q = 0): each axis's direction and a point
+        on it in the world, and the flange at q = 0; `fk_many` and `solve_path` evaluate it in numpy."""
+        c = self.client
+        self._set(np.zeros(self.n))
+        axes, points, prismatic = [], [], []
+        for j in self.joints:
+            info = c.getJointInfo(self.body, j)
+            s = c.getLinkState(self.body, j, computeForwardKinematics=True)  # the joint's frame (child link's)
+            w = quat_rotate(np.array(s[5], dtype=float), np.array(info[13], dtype=float))
+            axes.append(w / np.linalg.norm(w))
+            points.append(np.array(s[4], dtype=float))
+            prismatic.append(info[2] == pybullet.JOINT_PRISMATIC)
+        self._w, self._p = np.array(axes), np.array(points)
+        self._k = np.array([[[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]] for w in self._w])
+        self._k2 = self._k @ self._k
+        self._kp = np.einsum("nij,nj->ni", self._k, self._p)
+        self._k2p = np.einsum("nij,nj->ni", self._k2, self._p)
+        self._prismatic = np.array(prismatic)
+        self._home_flange = self._flange()
+        # checked against pybullet at a few poses: an arm the model does not describe (a URDF axis pybullet reads
+        # otherwise) is computed by pybullet, pose by pose
+        self._numpy = True
+        span = np.clip(self.upper, -math.pi, math.pi) - np.clip(self.lower, -math.pi, math.pi)
+        for f in (0.2, 0.5, 0.85):
+            q = np.clip(self.lower, -math.pi, math.pi) + f * span
+            p, r = self.fk_many(q[None, :])
+            pose = self.flange_pose(q) * self.tool
+            if not (np.allclose(p[0], pose.position, atol=1e-6) and np.allclose(r[0], quat_matrix(pose.orientation), atol=1e-6)):
+                self._numpy = False
+
+    def _exp(self, qs: np.ndarray, jacobian: bool = False):
+        """For joint positions qs (N, n): the product of the axes' motions (rotation (N,3,3), translation (N,3)),
+        and with `jacobian` each axis's direction and point in the world as the axes before it place it
+        ((N,n,3) each)."""
+        qs = np.asarray(qs, dtype=float)
+        m = len(qs)
+        rot = np.broadcast_to(np.eye(3), (m, 3, 3))
+        trans = np.zeros((m, 3))
+        axes = points = None
+        if jacobian:
+            axes, points = np.empty((m, self.n, 3)), np.empty((m, self.n, 3))
+        for i in range(self.n):
+            th = qs[:, i]
+            if jacobian:
+                axes[:, i] = rot @ self._w[i]
+                points[:, i] = rot @ self._p[i] + trans
+            if self._prismatic[i]:
+                trans = trans + (rot @ self._w[i]) * th[:, None]
+                continue
+            sin, vers = np.sin(th)[:, None], (1.0 - np.cos(th))[:, None]
+            k, k2 = self._k[i], self._k2[i]
+            r_i = np.eye(3) + sin[:, :, None] * k + vers[:, :, None] * k2
+            t_i = -(sin * self._kp[i] + vers * self._k2p[i])  # (I - R) p: the rotation about the axis through p
+            trans = trans + (rot @ t_i[:, :, None])[:, :, 0]
+            rot = rot @ r_i
+        return rot, trans, axes, points
+
+    def _tcp_at_home(self) -> tuple[np.ndarray, np.ndarray]:
+        """The TCP at q = 0 (this tool): position, rotation matrix."""
+        if getattr(self, "_home_tool", None) is not self.tool:
+            tcp = self._home_flange * self.tool
+            self._home_tcp = (tcp.position, quat_matrix(tcp.orientation))
+            self._home_tool = self.tool
+        return self._home_tcp
+
+    def fk_many(self, qs) -> tuple[np.ndarray, np.ndarray]:
+        """The TCP for many joint positions at once (N, n): positions (N, 3) and rotation matrices (N, 3, 3), in
+        numpy (the same arm as `fk`, to 1e-6 mm)."""
+        qs = np.atleast_2d(qs)
+        if not self._numpy:
+            poses = [self.fk(q) for q in qs]
+            return (np.array([p.position for p in poses]).reshape(-1, 3),
+                    np.array([quat_matrix(p.orientation) for p in poses]).reshape(-1, 3, 3))
+        rot, trans, _, _ = self._exp(qs)
+        p_tcp, r_tcp = self._tcp_at_home()
+        return rot @ p_tcp + trans, rot @ r_tcp
+
+    def solve_path(self, poses_p: np.ndarray, poses_r: np.ndarray, guess: np.ndarray,
+                   iterations: int = 12) -> tuple[np.ndarray, np.ndarray]:
+        """Newton (damped least squares) for many TCP poses at once, each from its own guess: (q (N, n), converged
+        (N,) bool: within 1e-7 m and 1e-7 rad, within the joint limits; none on an arm fk_many hands to pybullet)."""
+        q = np.array(guess, dtype=float)
+        if not self._numpy:
+            return q, np.zeros(len(q), dtype=bool)
+        p_tcp, r_tcp = self._tcp_at_home()
+        ok = np.zeros(len(q), dtype=bool)
+        for _ in range(iterations + 1):
+            rot, trans, axes, points = self._exp(q, jacobian=True)
+            x = rot @ p_tcp + trans
+            r_err = poses_r @ np.swapaxes(rot @ r_tcp, 1, 2)
+            vee = 0.5 * np.stack([r_err[:, 2, 1] - r_err[:, 1, 2], r_err[:, 0, 2] - r_err[:, 2, 0],
+                                  r_err[:, 1, 0] - r_err[:, 0, 1]], axis=1)
+            sin = np.linalg.norm(vee, axis=1)
+            cos = (np.trace(r_err, axis1=1, axis2=2) - 1.0) / 2.0
+            ang = np.arctan2(sin, cos)
+            scale = np.where(sin > 1e-12, ang / np.maximum(sin, 1e-300), 1.0)
+            err = np.concatenate([poses_p - x, vee * scale[:, None]], axis=1)
+            ok = (np.linalg.norm(err[:, :3], axis=1) <= 1e-7) & (ang <= 1e-7)
+            if ok.all():
+                break
+            lin = np.where(self._prismatic[None, :, None], axes, np.cross(axes, x[:, None, :] - points))
+            ang_j = np.where(self._prismatic[None, :, None], 0.0, axes)
+            jac = np.concatenate([lin, ang_j], axis=2).transpose(0, 2, 1)  # (N, 6, n)
+            a = jac @ jac.transpose(0, 2, 1) + 1e-12 * np.eye(6)
+            q = q + (jac.transpose(0, 2, 1) @ np.linalg.solve(a, err[:, :, None]))[:, :, 0]
+        ok &= np.all((q >= self.lower - 1e-9) & (q <= self.upper + 1e-9), axis=1)
+        return q, ok
 
     def close(self) -> None:
         try:

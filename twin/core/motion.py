@@ -26,7 +26,7 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 
 from .errors import MotionError
-from .geometry import Pose, slerp
+from .geometry import Pose, quat_matrices, rotation_angles, slerp, slerp_many
 from .kinematics import DEFAULT_ACCEL_TIME, ArmKinematics, JointLimit, check_limits
 
 #: Cartesian paths are solved at least every SAMPLE_STEP m and SAMPLE_ANGLE rad.
@@ -37,6 +37,9 @@ MAX_JOINT_JUMP = math.radians(5.0)
 #: The acceleration rises to its limit (and falls from it) in this time (s) at AccSet's Ramp 100: the jerk limit
 #: is the acceleration limit / RAMP_TIME.
 RAMP_TIME = 0.1
+#: Solve a Cartesian path's samples all at once (`_cartesian`); False: sample by sample only (the reference the
+#: batch solve is tested and benchmarked against)
+BATCH_IK = True
 #: MoveC: the three points must be this far apart and not within 0.06 degrees of one line.
 MIN_CIRCLE_POINT_DISTANCE = 0.001
 
@@ -130,6 +133,32 @@ class Profile:
         tau = min(tau - tc, tj)
         return x2 + v2 * tau + ap * tau * tau / 2 - j * tau ** 3 / 6, v2 + ap * tau - j * tau * tau / 2
 
+    def s_many(self, ts: np.ndarray) -> np.ndarray:
+        """s at many times at once (the planner's searches; `s` is the one the robot follows)."""
+        ts = np.asarray(ts, dtype=float)
+        if self.rate <= 0:
+            return np.ones_like(ts)
+        ta, d = self.ta, self.duration
+        with np.errstate(invalid="ignore", over="ignore"):
+            up = self._up_many(np.clip(ts, 0.0, ta))
+            down = self._up_many(np.clip(d - ts, 0.0, ta))
+            out = np.where(ts < ta, up, np.where(ts <= d - ta, self._up_many(np.array([ta]))[0] + self.rate * (ts - ta),
+                                                 1.0 - down))
+        return np.where(ts <= 0, 0.0, np.where(ts >= d, 1.0, out))
+
+    def _up_many(self, t: np.ndarray) -> np.ndarray:
+        """`_up`'s s at many times at once."""
+        ap, tj, tc, j = self.ap, self.tj, self.tc, self.jerk
+        if not math.isfinite(ap):
+            return self.rate * t
+        v1, x1 = ap * tj / 2, (j * tj ** 3 / 6 if tj > 0 else 0.0)
+        v2, x2 = v1 + ap * tc, x1 + v1 * tc + ap * tc * tc / 2
+        tau = t - tj
+        tau3 = np.minimum(tau - tc, tj)
+        first = j * t ** 3 / 6 if tj > 0 else np.zeros_like(t)
+        return np.where(t <= tj, first, np.where(tau <= tc, x1 + v1 * tau + ap * tau * tau / 2,
+                                                 x2 + v2 * tau3 + ap * tau3 * tau3 / 2 - j * tau3 ** 3 / 6))
+
     def s(self, t: float) -> tuple[float, float]:
         """(s, ds/dt) at time t."""
         if self.rate <= 0 or t >= self.duration:
@@ -188,6 +217,17 @@ class Trajectory:
         s, _ = self.profile.s(t)
         return self._at(s)[0]
 
+    def q_many(self, ts) -> np.ndarray:
+        """q at many times at once (N, axes): for the planner's searches along a motion."""
+        s = self.profile.s_many(ts)
+        if self._n == 0:
+            return np.repeat(self._knots[:1], len(s), axis=0)
+        i = np.clip(np.searchsorted(self._s, s, side="right") - 1, 0, self._n - 1)
+        s0, s1 = self._s[i], self._s[i + 1]
+        f = ((s - s0) / (s1 - s0))[:, None]
+        a, b = self._knots[i], self._knots[i + 1]
+        return a + f * (b - a)
+
     def qd(self, t: float) -> np.ndarray:
         s, v = self.profile.s(t)
         return self._at(s)[1] * v
@@ -204,6 +244,13 @@ class Trajectory:
     def tcp(self, q: np.ndarray) -> Pose:
         """The TCP for joint positions q of this motion (its tool); a point motion's q is the TCP's position."""
         return self.kin.fk(q) if self.kin is not None else Pose(q[:3])
+
+    def tcp_many(self, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """`tcp` of many joint positions (N, axes) at once: positions (N, 3), rotation matrices (N, 3, 3) or None
+        for a point motion."""
+        if self.kin is not None:
+            return self.kin.fk_many(qs)
+        return np.asarray(qs, dtype=float)[:, :3], None
 
     def __repr__(self) -> str:
         return f"Trajectory({self.kind} {self.name!r}, {self.duration:.3f} s)"
@@ -254,17 +301,31 @@ def _as_q(q: Iterable[float], n: int, name: str, what: str) -> np.ndarray:
 
 
 def _cartesian(kind: str, kin: ArmKinematics, q_start: np.ndarray, path: Callable[[float], Pose], length: float,
-               angle: float, speed: Speed, name: str) -> Trajectory:
-    """Solve IK along path(s), s in [0, 1], seeded sample to sample, and time it.
+               angle: float, speed: Speed, name: str, path_many=None, q_end: np.ndarray | None = None) -> Trajectory:
+    """Solve IK along path(s), s in [0, 1], and time it.
 
-    Where an axis moves more than MAX_JOINT_JUMP between two samples, the stretch is bisected (down to
-    1/16 of a sample); if it still jumps there, the arm would flip configuration and the move is refused.
+    All samples at once first (`ArmKinematics.solve_path`: Newton from the joint-space line to `q_end`, the
+    end point's solution; `path_many(s)` gives the TCP's positions and rotation matrices): kept when every
+    sample converged within the joint limits and no axis moves more than MAX_JOINT_JUMP between neighbours, the
+    path the sample-to-sample solve below finds, at a fraction of its cost (no step of the cell stalls while a
+    motion is planned). Otherwise sample by sample, each seeded by the previous solution: where an axis moves
+    more than MAX_JOINT_JUMP between two samples, the stretch is bisected (down to 1/16 of a sample); if it
+    still jumps there, the arm would flip configuration and the move is refused.
     """
     n = max(1, math.ceil(length / SAMPLE_STEP), math.ceil(angle / SAMPLE_ANGLE))
-    s_knots, knots = [0.0], [q_start]
-    for i in range(1, n + 1):
-        _sample(kin, path, (i - 1) / n, i / n, knots[-1], name, s_knots, knots, 0)
-    knots_arr, s_arr = np.array(knots), np.array(s_knots)
+    knots_arr = s_arr = None
+    if BATCH_IK and path_many is not None and q_end is not None:
+        s = np.arange(1, n + 1) / n
+        positions, rotations = path_many(s)
+        q, ok = kin.solve_path(positions, rotations, q_start + s[:, None] * (q_end - q_start))
+        knots = np.vstack([q_start, q])
+        if ok.all() and float(np.max(np.abs(np.diff(knots, axis=0)))) <= MAX_JOINT_JUMP:
+            knots_arr, s_arr = knots, np.concatenate([[0.0], s])
+    if knots_arr is None:
+        s_knots, knots_l = [0.0], [q_start]
+        for i in range(1, n + 1):
+            _sample(kin, path, (i - 1) / n, i / n, knots_l[-1], name, s_knots, knots_l, 0)
+        knots_arr, s_arr = np.array(knots_l), np.array(s_knots)
     profile = _timing(knots_arr, kin.limits, kin.accel, speed, length, angle, s_arr)
     return Trajectory(kind, name, knots_arr, profile, path, length, s_arr, kin)
 
@@ -316,9 +377,9 @@ def movej(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose | None
         check_limits(q1, kin.limits, name)
     # TCP path length and rotation, sampled along the joint-space line
     steps = max(2, min(64, math.ceil(float(np.max(np.abs(q1 - q0))) / math.radians(2.0))))
-    poses = [kin.fk(q0 + (q1 - q0) * (i / steps)) for i in range(steps + 1)]
-    length = sum(a.distance(b) for a, b in zip(poses, poses[1:]))
-    angle = sum(a.angle(b) for a, b in zip(poses, poses[1:]))
+    positions, rotations = kin.fk_many(q0 + (q1 - q0) * (np.arange(steps + 1) / steps)[:, None])
+    length = float(np.sum(np.linalg.norm(np.diff(positions, axis=0), axis=1)))
+    angle = float(np.sum(rotation_angles(rotations[:-1], rotations[1:])))
     knots = np.array([q0, q1])
     return Trajectory("MoveJ", name, knots, _timing(knots, kin.limits, kin.accel, speed, length, angle), None,
                       length, kin=kin)
@@ -349,9 +410,14 @@ def movel(kin: ArmKinematics, q_start: Iterable[float], target_pose: Pose, speed
     q0 = _as_q(q_start, kin.n, name, "the start")
     start = kin.fk(q0)
     end = Pose(target_pose.position, target_pose.orientation)
-    kin.ik(end, q0, name)  # an unreachable end point is reported as such, before any sampling
+    q1 = kin.ik(end, q0, name)  # an unreachable end point is reported as such, before any sampling
+
+    def path_many(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        positions = start.position + s[:, None] * (end.position - start.position)
+        return positions, quat_matrices(slerp_many(start.orientation, end.orientation, s))
+
     return _cartesian("MoveL", kin, q0, lambda s: start.interpolate(end, s), start.distance(end), start.angle(end),
-                      speed, name)
+                      speed, name, path_many, q1)
 
 
 def circle_through(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, name: str) -> tuple[np.ndarray, float, np.ndarray, np.ndarray, float, float]:
@@ -386,13 +452,18 @@ def movec(kin: ArmKinematics, q_start: Iterable[float], via_pose: Pose, target_p
     start = kin.fk(q0)
     end = Pose(target_pose.position, target_pose.orientation)
     centre, radius, u, w, _, phi = circle_through(start.position, via_pose.position, end.position, name)
-    kin.ik(end, q0, name)
+    q1 = kin.ik(end, q0, name)
 
     def path(s: float) -> Pose:
         a = s * phi
         return Pose(centre + radius * (math.cos(a) * u + math.sin(a) * w), slerp(start.orientation, end.orientation, s))
 
-    return _cartesian("MoveC", kin, q0, path, radius * phi, start.angle(end), speed, name)
+    def path_many(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        a = (s * phi)[:, None]
+        positions = centre + radius * (np.cos(a) * u + np.sin(a) * w)
+        return positions, quat_matrices(slerp_many(start.orientation, end.orientation, s))
+
+    return _cartesian("MoveC", kin, q0, path, radius * phi, start.angle(end), speed, name, path_many, q1)
 
 
 def payload_factor(load_kg: float, rated_kg: float | None) -> float:

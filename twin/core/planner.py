@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import quat_matrix, rotation_angles
 from .motion import Trajectory
 
 #: zone entry found to this time (s)
@@ -43,6 +44,8 @@ MIN_TURN = 1e-4
 LATE = 0.025
 #: samples of the corner path checked against the zone
 CORNER_SAMPLES = 16
+#: times tried at once where a search narrows an interval (15: 1/16 of it per round)
+REFINE = 15
 
 
 @dataclass(frozen=True)
@@ -189,44 +192,64 @@ class MotionQueue:
         if first < now - LATE:
             return None  # the TCP has entered the zone already: too late for a corner path
         first = max(first, now)
-        # the corner path must stay within the zone: start later (less overlap) until it does
-        if self._within(prev, nxt, first, point, radius):
+        # the corner path must stay within the zone: start later (less overlap) until it does, to 1/4096 of the
+        # time left (REFINE starts tried at once)
+        if self._within(prev, nxt, np.array([first]), point, radius)[0]:
             return first
         lo, hi = first, prev.end
-        for _ in range(12):
-            mid = (lo + hi) / 2
-            lo, hi = (lo, mid) if self._within(prev, nxt, mid, point, radius) else (mid, hi)
+        for _ in range(3):
+            starts = lo + (hi - lo) * np.arange(1, REFINE + 1) / (REFINE + 1)
+            good = np.flatnonzero(self._within(prev, nxt, starts, point, radius))
+            i = int(good[0]) if len(good) else REFINE
+            lo, hi = (float(starts[i - 1]) if i > 0 else lo), (float(starts[i]) if i < REFINE else hi)
         return hi
 
     @staticmethod
     def _entry(traj: Trajectory, point, radius: float, angle: float) -> float:
         """When (s into traj) its TCP enters the zone of `radius` (and `angle`) around `point` for good: the last
-        time it is outside, searched back from the end, then bisected."""
-        def inside(t: float) -> bool:
-            pose = traj.tcp(traj.q(t))
-            return pose.distance(point) <= radius and (not math.isfinite(angle) or pose.angle(point) <= angle)
+        time it is outside, searched back from the end in steps of 1/64 of the motion (64 at a time), then
+        narrowed down to ENTRY_RESOLUTION (REFINE times at once)."""
+        centre, orientation = point.position, quat_matrix(point.orientation)
+
+        def inside(ts: np.ndarray) -> np.ndarray:
+            positions, rotations = traj.tcp_many(traj.q_many(ts))
+            ok = np.linalg.norm(positions - centre, axis=1) <= radius
+            if math.isfinite(angle) and rotations is not None:
+                ok &= rotation_angles(rotations, orientation) <= angle
+            return ok
 
         d = traj.duration
-        lo, step = d, max(d / 64, 0.005)
-        while lo > 0 and inside(lo):
-            lo = max(lo - step, 0.0)
-        if inside(lo):
-            return 0.0
+        step = max(d / 64, 0.005)
+        top = d
+        while True:
+            times = np.maximum(top - step * np.arange(64), 0.0)
+            outside = np.flatnonzero(~inside(times))
+            if len(outside):
+                lo = float(times[outside[0]])
+                break
+            if times[-1] <= 0:
+                return 0.0
+            top = float(times[-1]) - step
         hi = min(lo + step, d)
-        while hi - lo > ENTRY_RESOLUTION:
-            mid = (lo + hi) / 2
-            lo, hi = (mid, hi) if not inside(mid) else (lo, mid)
+        while hi - lo > ENTRY_RESOLUTION:  # the last time outside between lo (outside) and hi (inside)
+            times = lo + (hi - lo) * np.arange(1, REFINE + 1) / (REFINE + 1)
+            outside = np.flatnonzero(~inside(times))
+            i = int(outside[-1]) if len(outside) else -1
+            lo, hi = (float(times[i]) if i >= 0 else lo), (float(times[i + 1]) if i + 1 < REFINE else hi)
         return hi
 
     @staticmethod
-    def _within(prev: Segment, nxt: Trajectory, start: float, point, radius: float) -> bool:
-        """Does the TCP of prev + nxt (started at `start`) stay within `radius` of `point` while they overlap?"""
+    def _within(prev: Segment, nxt: Trajectory, starts: np.ndarray, point, radius: float) -> np.ndarray:
+        """For each start time of nxt: does the TCP of prev + nxt stay within `radius` of `point` while they
+        overlap (CORNER_SAMPLES - 1 times checked)?"""
         q_end = prev.traj.q_end
-        for t in np.linspace(start, prev.end, CORNER_SAMPLES + 1)[1:-1]:
-            q = prev.traj.q(t - prev.start) + (nxt.q(t - start) - q_end)
-            if nxt.tcp(q).distance(point) > radius * (1 + 1e-6) + 1e-6:
-                return False
-        return True
+        f = np.arange(1, CORNER_SAMPLES) / CORNER_SAMPLES
+        ts = (starts[:, None] + (prev.end - starts)[:, None] * f[None, :]).ravel()
+        since = (ts.reshape(len(starts), -1) - starts[:, None]).ravel()
+        qs = prev.traj.q_many(ts - prev.start) + (nxt.q_many(since) - q_end)
+        positions, _ = nxt.tcp_many(qs)
+        far = np.linalg.norm(positions - point.position, axis=1) > radius * (1 + 1e-6) + 1e-6
+        return ~far.reshape(len(starts), -1).any(axis=1)
 
 
 # -- planning one motion ---------------------------------------------------------------------------------
