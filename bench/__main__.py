@@ -19,6 +19,7 @@ BENCHMARKS = {
     "st": "bench.st_scan",  # Structured Text PLC scan vs the Python PLC's, and a 2000-statement program  # twin map from the static signal table vs from a running cell
     "pollimage": "bench.poll_image",  # a master reading a poll in two requests: torn images with and without the hold
     "record": "bench.recording",  # the flight recorder's cost per lockstep step, Parquet and CSV
+    "load": "bench.load",  # everything at once (Modbus flood, OPC UA items, the page, recording) beside a quiet run
     "adapter": "bench.adapter",  # a front end in its own process: a snapshot through a socket pair vs shared memory
 }
 

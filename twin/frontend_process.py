@@ -97,12 +97,19 @@ def error_from(reply: tuple) -> TwinError:
 class FrontEndProcess:
     """A front end of a cell that runs in a process of its own (see the module docstring)."""
 
-    def __init__(self, name: str, target: str, options: Mapping | None = None, *, start_timeout: float = START_TIMEOUT):
+    def __init__(self, name: str, target: str, options: Mapping | None = None, *, local=None,
+                 start_timeout: float = START_TIMEOUT):
         """`target`: "module:factory"; in the new process `factory(options)` returns the front end, an object with
         `async start(remote) -> (lines, endpoints)` (lines for the log, endpoints for the `ready` event; raises
         OSError when it cannot bind, TwinError when it does not fit) and `async close() -> int` (its request
-        count)."""
+        count).
+
+        `local`: an optional companion in the simulation's process for what is not a signal (the page's frames:
+        poses taken from the twin): `local.start(cell, send)`, `local.on_message(payload)` for what the process
+        sends with `remote.send_local(payload)`, `local.after_snapshot(snapshot)` after every step (in the
+        stepping thread; `send(payload)` reaches the process's `remote.on_local` subscribers), `local.close()`."""
         self.name, self.target, self.options, self.start_timeout = name, target, dict(options or {}), start_timeout
+        self.local = local
         self.requests = 0
         self.process = None
         self.cell = None
@@ -120,6 +127,8 @@ class FrontEndProcess:
     async def start(self, cell) -> list[str]:
         self.cell = cell
         loop = asyncio.get_running_loop()
+        if self.local is not None:
+            self.local.start(cell, lambda payload: self._send(("local", payload)))
         mine, theirs = socket.socketpair()
         ctx = multiprocessing.get_context("spawn")  # a clean interpreter: no pybullet, no event loop copied
         self.process = ctx.Process(target=child_main, name=f"twin-{self.name}", daemon=True,
@@ -166,6 +175,9 @@ class FrontEndProcess:
         await self._end()
 
     async def _end(self) -> None:
+        local, self.local = self.local, None
+        if local is not None:
+            local.close()
         if self._writer is not None:
             self._writer.close()
         if self._reader_task is not None:
@@ -203,6 +215,8 @@ class FrontEndProcess:
 
     def _on_snapshot(self, snapshot) -> None:
         self._send_snapshot(snapshot)
+        if self.local is not None:
+            self.local.after_snapshot(snapshot)
         ex = self.cell.exchange
         if ex.fault:
             self._fail_waiting()
@@ -269,6 +283,9 @@ class FrontEndProcess:
         elif kind in ("ready", "oserror", "twinerror", "failed"):
             if not self._started.done():
                 self._started.set_result(msg)
+        elif kind == "local":
+            if self.local is not None:
+                self.local.on_message(msg[1])
         elif kind == "log":
             self.cell.log(f"{self.name}: {msg[2]}", msg[1])
         elif kind == "bye":
@@ -326,6 +343,7 @@ class Remote:
         self._values: dict[str, object] = {}
         self._writer = writer
         self._subscribers: list[Callable[[RemoteSnapshot], None]] = []
+        self._local: list[Callable[[object], None]] = []
         self._replies: dict[int, asyncio.Future] = {}
         self._next = 0
 
@@ -361,6 +379,14 @@ class Remote:
     def control(self, action: str, *args) -> None:
         """The runner's pause, resume, single_step or request(n) (the page's buttons)."""
         self._send(("control", action, args))
+
+    def send_local(self, payload) -> None:
+        """A message for the front end's companion in the simulation's process (`FrontEndProcess(local=...)`)."""
+        self._send(("local", payload))
+
+    def on_local(self, fn: Callable[[object], None]) -> None:
+        """`fn(payload)` for every message the companion sends, in this process's event loop."""
+        self._local.append(fn)
 
     def log(self, text: str, level: int = logging.WARNING) -> None:
         """A line in the simulation's log."""
@@ -423,6 +449,9 @@ async def _child(target: str, sock: socket.socket) -> None:
                     remote._snap(*msg[1:])
                 elif kind == "reply":
                     remote._reply(msg[1], msg[2])
+                elif kind == "local":
+                    for fn in tuple(remote._local):
+                        fn(msg[1])
                 elif kind == "stop":
                     break
         except (asyncio.IncompleteReadError, ConnectionError, OSError):
