@@ -203,11 +203,14 @@ class Observer:
         """The state now as plain tuples: (step, time, values, poses flat (x y z qx qy qz qw per body), joints).
 
         The cheap form a recorder keeps for every step; `frame()` makes a `Frame` of it. `values`: the
-        signals' values in `scene.signals`' order when the caller has them already (a published snapshot)."""
+        signals' values in `scene.signals`' order when the caller has them already (a published snapshot).
+        What the step itself read (the joints' positions, the targets' poses: `Twin.step_readings`) is taken
+        from it, not asked of pybullet again: the same numbers, bit for bit, for a fraction of the cost."""
         twin, cid, pybullet = self.twin, self._cid, self._pb
         if values is None:
             read = twin.read
             values = tuple([read(n) for n in self._names])
+        readings = twin.step_readings() if twin.step_count else None
         poses = list(self._base_pose_t)
         # pybullet's functions called directly with the connection's id: BulletClient's per-call wrapper
         # costs more than the calls themselves
@@ -219,15 +222,27 @@ class Observer:
                 poses += s[4]
                 poses += s[5]
         static = self._static_pose
+        known = dict(zip(readings[2], readings[3])) if readings is not None else {}
         for uid in self._other_ids:
             if uid in static:
                 poses += static[uid]
                 continue
-            pos, orn = pybullet.getBasePositionAndOrientation(uid, physicsClientId=cid)
-            poses += pos
-            poses += orn
-        joints = tuple([s[0] for s in pybullet.getJointStates(self._machine, self._joint_indices, physicsClientId=cid)]) \
-            if self._joint_indices else ()
+            pose = known.get(uid)
+            if pose is None:
+                pose = pybullet.getBasePositionAndOrientation(uid, physicsClientId=cid)
+            poses += pose[0]
+            poses += pose[1]
+        if not self._joint_indices:
+            joints = ()
+        elif readings is not None and readings[0] == self._joint_indices:
+            joints = tuple(readings[1])
+        else:
+            have = dict(zip(readings[0], readings[1])) if readings is not None else {}
+            missing = [j for j in self._joint_indices if j not in have]
+            if missing:
+                have.update(zip(missing, (s[0] for s in pybullet.getJointStates(self._machine, missing,
+                                                                                   physicsClientId=cid))))
+            joints = tuple([have[j] for j in self._joint_indices])
         return twin.step_count, twin.time, values, tuple(poses), joints
 
     def frame(self, raw: tuple | None = None) -> Frame:

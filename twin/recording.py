@@ -44,9 +44,12 @@ from __future__ import annotations
 import contextlib
 import csv
 import io
+import itertools
 import json
 import math
+import operator
 import os
+import struct
 from itertools import islice
 from pathlib import Path
 
@@ -90,12 +93,17 @@ class _Layout:
     """Where each signal of a scene goes in a stream's narrow record batch: by kind, in the scene's order."""
 
     KINDS = ("float64", "bool", "int64", "string")
+    DTYPES = {"float64": np.dtype("<f8"), "bool": np.dtype(bool), "int64": np.dtype("<i8")}
 
     def __init__(self, scene: Scene):
         self.columns = columns_of(scene)
         kinds = [t for _, t in self.columns[2:2 + len(scene.signals)]]
         self.index = {k: [i for i, t in enumerate(kinds) if t == k] for k in self.KINDS}
         self.n_poses, self.n_joints = 7 * len(scene.bodies), len(scene.joints)
+        codes = {"float64": "d", "bool": "?", "int64": "q", "string": "x"}  # (strings are not packed)
+        self._pickers = [(k, operator.itemgetter(*self.index[k]), len(self.index[k]),
+                          struct.Struct(f"<{len(self.index[k])}{codes[k]}")) for k in self.KINDS if self.index[k]]
+        self._pack_poses, self._pack_joints = struct.Struct(f"<{self.n_poses}d"), struct.Struct(f"<{self.n_joints}d")
 
     def schema(self, pa, metadata: dict | None = None):
         types = {"float64": pa.float64(), "bool": pa.bool_(), "int64": pa.int64(), "string": pa.string()}
@@ -105,23 +113,37 @@ class _Layout:
                    if width]
         return pa.schema(fields, metadata=metadata)
 
+    def blocks(self, group: "_Group") -> dict:
+        """A group's rows as numpy blocks: step, time, one (rows, width) block per kind of signal, poses, joints.
+        (Each row's numbers packed by a `struct` into bytes numpy then takes as they are: a third of what
+        numpy's own conversion of a list of tuples costs.)"""
+        n = group.n
+        out = {"step": np.array(group.steps, dtype=np.int64), "time": np.array(group.times, dtype=float)}
+        for kind, pick, width, packer in self._pickers:
+            picked = map(pick, group.values)
+            if kind == "string":
+                out[kind] = np.array(list(picked), dtype=object).reshape(n, width)
+                continue
+            pack = packer.pack
+            data = b"".join([pack(*v) for v in picked] if width > 1 else [pack(v) for v in picked])
+            out[kind] = np.frombuffer(data, self.DTYPES[kind]).reshape(n, width)
+        for key, width, packer in (("poses", self.n_poses, self._pack_poses), ("joints", self.n_joints, self._pack_joints)):
+            pack = packer.pack
+            out[key] = np.frombuffer(b"".join([pack(*v) for v in getattr(group, key)]), float).reshape(n, width)
+        return out
+
     def batch(self, pa, schema, group: "_Group"):
         """A group of rows -> one narrow record batch (a handful of buffers whatever the column count)."""
-        n = group.n
-        types = {"float64": float, "bool": bool, "int64": np.int64}
-        arrays = [pa.array(group.steps[:n]), pa.array(group.times[:n])]
-        vals = group.values[:n]
+        b = self.blocks(group)
+        arrays = [pa.array(b["step"]), pa.array(b["time"])]
         for kind in self.KINDS:
-            if not self.index[kind]:
-                continue
-            block = vals[:, self.index[kind]]
-            flat = [str(v) for v in block.ravel()] if kind == "string" else block.astype(types[kind]).ravel()
-            arrays.append(pa.FixedSizeListArray.from_arrays(
-                pa.array(flat, schema.field(f"signals:{kind}").type.value_type), len(self.index[kind])))
-        floats = group.floats[:n]
-        for block, width in ((floats[:, :self.n_poses], self.n_poses), (floats[:, self.n_poses:], self.n_joints)):
+            if self.index[kind]:
+                flat = [str(v) for v in b[kind].ravel()] if kind == "string" else b[kind].ravel()
+                arrays.append(pa.FixedSizeListArray.from_arrays(
+                    pa.array(flat, schema.field(f"signals:{kind}").type.value_type), len(self.index[kind])))
+        for key, width in (("poses", self.n_poses), ("joints", self.n_joints)):
             if width:
-                arrays.append(pa.FixedSizeListArray.from_arrays(pa.array(np.ascontiguousarray(block).ravel()), width))
+                arrays.append(pa.FixedSizeListArray.from_arrays(pa.array(b[key].ravel()), width))
         return pa.RecordBatch.from_arrays(arrays, schema=schema)
 
     def wide(self, pa, narrow) -> dict:
@@ -153,34 +175,31 @@ class _Layout:
 
 
 class _Group:
-    """Rows being buffered, in preallocated arrays: a row costs a few array stores and no objects the
-    garbage collector has to follow."""
+    """Rows being buffered: a row costs five list appends (the tuples `Observer.raw` made, kept as they are);
+    the group becomes arrays once, when it is written."""
 
     def __init__(self, layout: _Layout, capacity: int):
-        self.n, self.t0 = 0, None
-        self.steps = np.empty(capacity, dtype=np.int64)
-        self.times = np.empty(capacity, dtype=float)
-        self.values = np.empty((capacity, sum(len(v) for v in layout.index.values())), dtype=object)
-        self.floats = np.empty((capacity, layout.n_poses + layout.n_joints), dtype=float)
-        self.n_poses = layout.n_poses
+        self.n, self.t0, self.capacity = 0, None, capacity
+        self.steps, self.times, self.values, self.poses, self.joints = [], [], [], [], []
 
     def add(self, row: tuple) -> bool:
         """Store an Observer.raw row; False when full."""
-        i = self.n
-        if i == len(self.steps):
+        if self.n == self.capacity:
             return False
-        self.steps[i], self.times[i], self.values[i], f = row[0], row[1], row[2], self.floats[i]
-        f[:self.n_poses], f[self.n_poses:] = row[3], row[4]
-        self.n = i + 1
+        step, t, values, poses, joints = row
+        self.steps.append(step)
+        self.times.append(t)
+        self.values.append(values)
+        self.poses.append(poses)
+        self.joints.append(joints)
+        self.n += 1
         if self.t0 is None:
-            self.t0 = row[1]
+            self.t0 = t
         return True
 
     def rows(self):
         """The rows again as (step, time, values, poses, joints) tuples (the CSV writer without pyarrow)."""
-        for i in range(self.n):
-            f = self.floats[i]
-            yield int(self.steps[i]), float(self.times[i]), tuple(self.values[i]), f[:self.n_poses], f[self.n_poses:]
+        return zip(self.steps, self.times, self.values, self.poses, self.joints)
 
 
 class Recorder(ObservingDevice):
@@ -193,6 +212,7 @@ class Recorder(ObservingDevice):
         """`exchange` (a served cell's `twin.exchange.Exchange`): record each published snapshot (its values
         are already read) instead of stepping with the twin."""
         self.path = Path(path)
+        self._parquet = is_parquet(self.path)
         self.observer = observer or Observer(twin)
         self.scene = self.observer.scene
         self.columns = columns_of(self.scene)
@@ -213,6 +233,8 @@ class Recorder(ObservingDevice):
         except OSError as exc:
             raise RecordingError(f"{self.path}: cannot write a recording: {exc.strerror or exc}") from None
         self.capture()  # step 0, or wherever the twin is now
+        if self._pa is not None:  # the writer's first use imports and sets up what it needs: not at a step's cost
+            self._encode(self._group)
         names = [sig["name"] for sig in self.scene.signals]
         if exchange is not None and list(islice(exchange.snapshot.values, len(names))) != names:
             exchange = None  # its snapshot does not list the signals first, in order: read them here
@@ -281,19 +303,18 @@ class Recorder(ObservingDevice):
 
     def _write_group(self, rows: _Group) -> None:
         """A group of rows -> one record batch (Parquet's stream) or lines (CSV), written with one
-        system call. Runs in the writer thread."""
+        system call."""
+        _write_all(self._fd, self._encode(rows))
+
+    def _encode(self, rows: _Group) -> bytes:
         pa = self._pa
-        if is_parquet(self.path):
-            sink = pa.BufferOutputStream()
-            with pa.ipc.new_stream(sink, self._schema) as w:
-                w.write_batch(self.layout.batch(pa, self._schema, rows))
-            data = sink.getvalue().to_pybytes()[len(self._stream_head):]  # the batch, without a second schema
-            data = data[:-len(STREAM_END)] if data.endswith(STREAM_END) else data  # nor an end mark
+        if self._parquet:  # one stream message: what the stream writer would put after the schema
+            data = self.layout.batch(pa, self._schema, rows).serialize().to_pybytes()
         elif pa is not None:
-            data = _csv_lines(pa, self.layout, self.layout.batch(pa, self._schema, rows))
+            data = _csv_lines(pa, self.layout, rows)
         else:
             data = _csv_lines_plain(self.layout, rows.rows())
-        _write_all(self._fd, data)
+        return data
 
     def close(self) -> None:
         """Write what is buffered and finish the file (a Parquet file: the stream becomes Parquet)."""
@@ -323,17 +344,68 @@ def _write_all(fd: int, data: bytes) -> None:
         data = data[os.write(fd, data):]
 
 
-def _csv_lines(pa, layout: _Layout, narrow) -> bytes:
-    """A batch as CSV lines (no header) by pyarrow's writer: bools as 1/0, floats in their shortest form."""
-    import pyarrow.csv as pcsv
+def _csv_lines(pa, layout: _Layout, group: _Group) -> bytes:
+    """A group as CSV lines (no header), formatted by Arrow in a few vectorised calls whatever the column
+    count. A number is formatted once per run of equal values down its column (most signals and the bodies at
+    rest keep theirs from step to step): only the values that changed are cast to text (floats in their
+    shortest form that reads back bit for bit, bools as 1/0); one take puts every cell's text in place and one
+    call per line joins them."""
+    import pyarrow.compute as pc
 
-    types = {"int64": pa.int64(), "float64": pa.float64(), "bool": pa.int8(), "string": pa.string()}
-    wide = layout.wide(pa, narrow)
-    arrays = [pa.array(wide[n].astype(np.int8) if t == "bool" else wide[n], types[t]) for n, t in layout.columns]
-    sink = pa.BufferOutputStream()
-    pcsv.write_csv(pa.Table.from_arrays(arrays, names=[n for n, _ in layout.columns]), sink,
-                   write_options=pcsv.WriteOptions(include_header=False, quoting_style="needed"))
-    return sink.getvalue().to_pybytes()
+    b = layout.blocks(group)
+    n = group.n
+    parts, places, total = [], {}, 0  # texts to concatenate; per block, each cell's index into them
+
+    def add(key: str, block: np.ndarray, numeric: bool = True) -> None:
+        nonlocal total
+        if numeric:
+            changed, where = _runs(block)
+            text = pa.array(block[changed]).cast(pa.string())
+        else:
+            text, where = pa.array([_csv_field(str(v)) for v in block.ravel()], pa.string()), \
+                np.arange(block.size, dtype=np.int64).reshape(block.shape)
+        parts.append(text)
+        places[key] = where + total
+        total += len(text)
+
+    add("step", b["step"].reshape(n, 1))
+    add("time", b["time"].reshape(n, 1))
+    for kind in layout.KINDS:
+        if layout.index[kind]:
+            add(kind, b[kind].astype(np.int8) if kind == "bool" else b[kind], kind != "string")
+    signals = np.empty((n, sum(len(v) for v in layout.index.values())), dtype=np.int64)
+    for kind in layout.KINDS:
+        if layout.index[kind]:
+            signals[:, layout.index[kind]] = places[kind]  # back in the scene's order
+    for key, width in (("poses", layout.n_poses), ("joints", layout.n_joints)):
+        if width:
+            add(key, b[key])
+    take = np.hstack([places["step"], places["time"], signals] + [places[k] for k in ("poses", "joints") if k in places])
+    cells = pc.take(pa.concat_arrays(parts), pa.array(take.ravel()))
+    width = take.shape[1]
+    ends = pa.array(np.arange(0, n * width + 1, width, dtype=np.int32))
+    lines = pc.binary_join(pa.ListArray.from_arrays(ends, cells), ",")
+    return ("\n".join(lines.to_pylist()) + "\n").encode("utf-8")
+
+
+def _runs(block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For a (rows, columns) block of numbers: which cells differ (bit for bit) from the cell above (the
+    first row always), and for every cell the index, among those cells in row-major order, of the one that
+    starts its run."""
+    n, w = block.shape
+    bits = np.ascontiguousarray(block).view(f"i{block.dtype.itemsize}")
+    changed = np.ones((n, w), dtype=bool)
+    changed[1:] = bits[1:] != bits[:-1]
+    rank = np.cumsum(changed.ravel()) - 1
+    start = np.maximum.accumulate(np.where(changed, np.arange(n)[:, None], 0), axis=0)
+    return changed, rank[start * w + np.arange(w)]
+
+
+def _csv_field(text: str) -> str:
+    """A text as one CSV field (quoted when empty or when it holds a separator, a quote or a line break)."""
+    if not text or any(c in text for c in ',"\r\n'):
+        return '"' + text.replace('"', '""') + '"'
+    return text
 
 
 def _csv_lines_plain(layout: _Layout, rows) -> bytes:

@@ -135,3 +135,39 @@ def test_a_line_cut_short_at_the_end_of_a_csv_recording_is_not_a_row(tmp_path):
     path.write_text(text + text.splitlines()[-1][:25])  # a crash in the middle of a line
     cut = Recording.open(path)
     assert len(cut) == len(whole) == 31 and cut.column("time").tolist() == whole.column("time").tolist()
+
+
+CHUCK = STATIONS.parent / "tests" / "core" / "data" / "chuck3"
+
+
+@pytest.mark.parametrize("station, inputs", [(CHUCK, {"jaw_1": 0.02}), (RING, {"L2": 0.3, "L5": 0.01})])
+@pytest.mark.parametrize("suffix", ["parquet", "csv"])
+def test_every_pose_is_what_pybullet_gives_after_the_step(tmp_path, station, inputs, suffix):
+    """The recorder takes what the step read already (joints, targets) instead of asking again: each row's
+    poses and joint positions are still, to the bit, what pybullet itself answers after that step; on a
+    mimic-coupled chuck (follower joints the step does not read) and on an arm with a gripper."""
+    if suffix == "parquet":
+        pytest.importorskip("pyarrow")
+    path = tmp_path / f"run.{suffix}"
+    truth = []
+    with Twin.from_station(station) as twin, record(twin, path) as rec:
+        c, body, scene = twin.world.client, twin.world.machine, rec.scene
+        links = {n: i for n, i in twin.world.link_index.items() if i >= 0}
+        joints = {c.getJointInfo(body, j)[1].decode(): j for j in range(c.getNumJoints(body))}
+        for name, value in inputs.items():
+            twin.write(name, value)
+        if twin.robot is not None:
+            twin.move("MoveJ", "app_right")
+        for _ in range(40):
+            twin.step()
+            row = []
+            for b in scene.bodies[1:]:  # (the first is the machine's fixed base)
+                pos, orn = (c.getLinkState(body, links[b])[4:6] if b in links
+                            else c.getBasePositionAndOrientation(twin.world.body_ids[b]))
+                row += [*pos, *orn]
+            truth.append((row, [c.getJointState(body, joints[j])[0] for j in scene.joints]))
+    got = Recording.open(path)
+    for k, (poses, qs) in enumerate(truth, start=1):
+        frame = got.frame(k)
+        assert frame.poses[1:].ravel().tolist() == poses, k
+        assert frame.joints.tolist() == qs, k

@@ -464,6 +464,15 @@ class Gripper:
             self._sent = sent
 
     @property
+    def step_positions(self) -> list[float] | None:
+        """The input joints' positions (`joint_ids`' order) as read after the last step's last substep."""
+        return self._step_positions
+
+    @property
+    def joint_ids(self) -> list[int]:
+        return self._joint_ids
+
+    @property
     def quiet(self) -> bool:
         """Every drive stood at its goal, pressing on nothing, at the last step's first substep."""
         return self._quiet

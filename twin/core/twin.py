@@ -221,14 +221,37 @@ class Twin:
             out[contact_key] = bool(finger.contacts)
             out[force_key] = finger.force
             out[status_key] = finger.status
+        arm = None
         if self.robot is not None:
             out["robot.busy"] = self.robot.busy(self.time)
-            for key, q in zip(self._robot_keys, self.robot.positions()):
+            arm = self.robot.positions()
+            for key, q in zip(self._robot_keys, arm):
                 out[key] = q
         pose = self.world.client.getBasePositionAndOrientation
+        poses = []
         for uid, x_key, y_key, z_key in self._target_keys:
-            out[x_key], out[y_key], out[z_key] = pose(uid)[0]
+            p = pose(uid)
+            poses.append(p)
+            out[x_key], out[y_key], out[z_key] = p[0]
         self._outputs = out
+        self._read = (self.step_count, arm, self.gripper.step_positions, poses)
+
+    def step_readings(self) -> tuple[list[int], list[float], list[int], list[tuple]] | None:
+        """What the step read of the bodies anyway, for an observer that would otherwise ask pybullet again
+        (a recorder, at every step): (machine joint indices, their positions: the arm's joints and the gripper
+        inputs' joints; target body ids, their (position, orientation)), exactly as pybullet gave them after
+        the step's last physics substep. None before the first step."""
+        step, arm, grip, poses = self._read
+        if step != self.step_count or not step:
+            return None
+        ids, q = [], []
+        if arm is not None:
+            ids += self.robot.joints
+            q += arm
+        if grip is not None:
+            ids += self.gripper.joint_ids
+            q += grip
+        return ids, q, [uid for uid, *_ in self._target_keys], poses
 
     def _index_outputs(self) -> None:
         """The output names published at every step, spelled out once (not formatted anew at every step)."""
