@@ -73,6 +73,7 @@ ERRORS = {
     "ERR_UNKINO": 1055,
     "ERR_NO_ALIASIO_DEF": 1056,
     "ERR_NORUNUNIT_WARN": 1057,
+    "ERR_PATHDIST": 1058,
 }
 LONG_JMP_ALL_ERR = -1.0  # `ERROR (LONG_JMP_ALL_ERR)`: the handler takes every error raised to it
 ERR_NAMES = {v: k for k, v in ERRORS.items()}

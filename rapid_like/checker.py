@@ -34,11 +34,10 @@ _APPROXIMATE = {
     "pathresol": "the path resolution does not change the simulated motion",
     "cirpathmode": "the tool orientation along a circle is not changed by CirPathMode",
     "worldacclim": "acceleration limits are not simulated",
-    "stopmove": "StopMove only holds the next motion until StartMove (the motions under way go on)",
-    "startmove": "StartMove releases motions held by StopMove",
-    "clearpath": "the motions handed to the planner are not cleared",
-    "storepath": "StorePath keeps nothing",
-    "restopath": "RestoPath restores nothing",
+    "storepath": "without a StopMove before it, StorePath stands where the path is at the end of the motion under "
+                 "way (on its corner path if it blends)",
+    "restopath": "no regain movement: RestoPath needs the robot back within 1 mm of where the stored path stands "
+                 "(else ERR_PATHDIST)",
     "pdispset": "program displacement is not applied to the motions",
     "pdispoff": "program displacement is not applied to the motions",
     "eoffsoff": "external axes are not simulated",

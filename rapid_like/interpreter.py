@@ -65,6 +65,7 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         self.interrupts = InterruptTable(self)
         self.sockets: list = []
         self.stop_move = False
+        self.stored_paths: list[bool] = []  # StorePath levels: the stop_move of each stored path
         self.files: dict[str, str] = {}  # files the program wrote (Open ... \\Write; Write), by path
         self.concurrent = None  # the handle of a \\Conc motion still running
         self.last_position: tuple | None = None  # the last Cartesian target (mm), for offline motion times

@@ -158,6 +158,33 @@ class TwinHost:
         t = robot.ready_time(handle) if what == "ready" else robot.end_time(handle)
         return None if t is None else to_ns(t)
 
+    # -- path control: StopMove, StartMove, ClearPath, StorePath, RestoPath (twin.core.planner.PathClock) ----
+    def stop_path(self, quick: bool, at_end: bool = False) -> None:
+        self.twin.robot.stop_path(self.twin.time, quick, at_end)
+
+    def path_standing(self) -> bool:
+        return self.twin.robot.path_standing(self.twin.time)
+
+    def stand_time(self) -> int | None:
+        """When the robot will stand on its path (ns), for runners that jump from event to event."""
+        t = self.twin.robot.stand_time(self.twin.time)
+        return None if t is None else to_ns(t)
+
+    def start_path(self) -> None:
+        self.twin.robot.start_path(self.twin.time)
+
+    def clear_path(self) -> None:
+        self.twin.robot.clear_path(self.twin.time)
+
+    def store_path(self) -> None:
+        self.twin.robot.store_path(self.twin.time)
+
+    def restore_path(self) -> None:
+        try:
+            self.twin.robot.restore_path(self.twin.time)
+        except MotionError as exc:
+            raise HostError(str(exc), "ERR_PATHDIST") from None
+
     def motor_torque(self, axis: int) -> float:
         """GetMotorTorque: the physics arm's axis torque (N m); 0 without physics (an offline run)."""
         torque = getattr(self.twin.robot, "motor_torque", None)

@@ -282,24 +282,68 @@ class SystemMixin:
         ref.set(True)
         return not was
 
-    # ---- path control (motions are not queued: see docs/rapid.md) ---------------------------------
+    # ---- path control (docs/rapid.md: the host's robot stops on its path, twin.core.planner.PathClock) -------
     def i_stopmove(self, s, arg, text, bound):
+        quick = bool(arg("quick"))
+        arg("allmotiontasks")
         self.stop_move = True
+        stop = getattr(self.host, "stop_path", None)
+        if stop is not None:
+            stop(quick)
         yield from ()
 
     def i_startmove(self, s, arg, text, bound):
+        for k in bound:
+            arg(k)
         self.stop_move = False
+        start = getattr(self.host, "start_path", None)
+        if start is not None:
+            start()
         yield from ()
 
     i_stopmovereset = i_startmove
     i_startmoveretry = i_startmove
+
+    def _standing(self, s, what: str):
+        """Wait until the robot stands on its path (a StopMove's deceleration over)."""
+        standing = getattr(self.host, "path_standing", None)
+        while standing is not None and not standing():
+            at = getattr(self.host, "stand_time", lambda: None)()
+            yield from self.pause(Wait("motion", at, f"{what}: the robot stopping on its path", s.span))
+
+    def i_clearpath(self, s, arg, text, bound):
+        yield from self._standing(s, "ClearPath")
+        clear = getattr(self.host, "clear_path", None)
+        if clear is not None:
+            clear()
+
+    def i_storepath(self, s, arg, text, bound):
+        arg("keepsync")
+        stop = getattr(self.host, "stop_path", None)
+        if stop is not None and not self.stop_move:  # the motion under way goes on to its end, then stands
+            stop(False, True)
+        yield from self._standing(s, "StorePath")
+        store = getattr(self.host, "store_path", None)
+        if store is not None:
+            store()
+        self.stored_paths.append(self.stop_move)  # the temporary path's motions run
+        self.stop_move = False
+
+    def i_restopath(self, s, arg, text, bound):
+        if not self.stored_paths:
+            raise self.fail("RestoPath: no path is stored (StorePath first)", s.span)
+        yield from self._standing(s, "RestoPath")
+        restore = getattr(self.host, "restore_path", None)
+        if restore is not None:
+            restore()
+        self.stop_move = self.stored_paths.pop()
 
     def _accept(self, s, arg, text, bound):
         for k in bound:
             arg(k)
         yield from ()
 
-    i_clearpath = i_storepath = i_restopath = i_singarea = i_cirpathmode = i_pathresol = _accept
+    i_singarea = i_cirpathmode = i_pathresol = _accept
     i_gripload = i_worldacclim = i_pathacclim = i_pdispoff = i_pdispset = i_eoffsoff = _accept
 
     i_pdispon = i_eoffsset = i_eoffson = i_waitsynctask = _accept

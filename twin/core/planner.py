@@ -44,6 +44,10 @@ MIN_TURN = 1e-4
 LATE = 0.025
 #: samples of the corner path checked against the zone
 CORNER_SAMPLES = 16
+#: RestoPath: the robot must be back within this distance (m) of where the stored path stands
+REGAIN_DISTANCE = 0.001
+#: StopMove without \\Quick decelerates each axis at this share of its acceleration limit at most
+STOP_SHARE = 0.5
 #: times tried at once where a search narrows an interval (15: 1/16 of it per round)
 REFINE = 15
 
@@ -252,6 +256,80 @@ class MotionQueue:
         return ~far.reshape(len(starts), -1).any(axis=1)
 
 
+# -- the motion clock: StopMove and StartMove -------------------------------------------------------------
+class PathClock:
+    """The motion queue's time (tau, s) as a function of the cell's time t: tau = t - t0 while the robot runs.
+
+    `stop(t, ramp)` (StopMove) lowers the clock's rate to 0 over `ramp` seconds as a half cosine, so the robot
+    decelerates on its planned path (blends included: they are functions of tau) and stands; `start(t, ramp)`
+    (StartMove) raises it to 1 again the same way, and the rest of the same path follows. Every motion keeps its
+    plan; only when it runs changes. `shift(dt)` delays everything (a paused robot)."""
+
+    def __init__(self, t0: float):
+        # the present phase: from t_a (tau_a there) the rate goes from r_from to r_to in `ramp` s, then stays
+        self.t_a, self.tau_a, self.r_from, self.r_to, self.ramp = float(t0), 0.0, 1.0, 1.0, 0.0
+
+    @property
+    def stopping(self) -> bool:
+        """Stopped or stopping (StopMove), until `start`."""
+        return self.r_to == 0.0
+
+    def shift(self, dt: float) -> None:
+        self.t_a += dt
+
+    def _phase(self, t: float) -> tuple[float, float]:
+        """(tau, rate) at t."""
+        u, T, r0, r1 = t - self.t_a, self.ramp, self.r_from, self.r_to
+        if u <= 0:
+            return self.tau_a + u * r0, r0
+        if u >= T:
+            return self.tau_a + r1 * T + (r0 - r1) * T / 2 + r1 * (u - T), r1
+        w = math.pi * u / T
+        return self.tau_a + r1 * u + (r0 - r1) * (u / 2 + T / (2 * math.pi) * math.sin(w)), r1 + (r0 - r1) * (1 + math.cos(w)) / 2
+
+    def tau(self, t: float) -> float:
+        return self._phase(t)[0]
+
+    def rate(self, t: float) -> float:
+        return self._phase(t)[1]
+
+    def t_of(self, tau: float) -> float | None:
+        """When the clock reaches tau (at or after the present phase's start), None if it stands before."""
+        d, T = tau - self.tau_a, self.ramp
+        if d <= 0:
+            return self.t_a + d / self.r_from if self.r_from > 0 else self.t_a
+        after = self.r_to * T + (self.r_from - self.r_to) * T / 2  # tau gained over the ramp
+        if d >= after:
+            return None if self.r_to == 0 else self.t_a + T + (d - after) / self.r_to
+        lo, hi = self.t_a, self.t_a + T  # within the ramp: tau rises monotonically
+        for _ in range(60):
+            mid = (lo + hi) / 2
+            lo, hi = (mid, hi) if self.tau(mid) < tau else (lo, mid)
+        return hi
+
+    def _to(self, t: float, rate: float, ramp: float) -> None:
+        self.tau_a, self.r_from = self._phase(t)
+        self.t_a, self.r_to = float(t), rate
+        self.ramp = ramp * abs(rate - self.r_from)  # (from a rate part-way: the same steepness)
+
+    def stop(self, t: float, ramp: float) -> None:
+        if not self.stopping:
+            self._to(t, 0.0, ramp)
+
+    def start(self, t: float, ramp: float) -> None:
+        if self.stopping:
+            self._to(t, 1.0, ramp)
+
+
+def stop_ramp(kin, qd: np.ndarray, quick: bool) -> float:
+    """How long (s) a StopMove takes to bring the clock's rate from 1 to 0 as a half cosine when the axes move at
+    qd: the rate's steepest fall (pi / 2 / ramp) times each axis's speed at most its acceleration limit (\\Quick)
+    or half of it (StopMove: a longer braking distance, as at a program stop)."""
+    accel = np.asarray(kin.accel if kin is not None else np.full(len(qd), 10.0), dtype=float)
+    share = 1.0 if quick else STOP_SHARE
+    return float(math.pi / 2 * np.max(np.abs(qd) / (share * accel))) if len(qd) else 0.0
+
+
 # -- planning one motion ---------------------------------------------------------------------------------
 def configuration(q: np.ndarray) -> tuple[int, int, int]:
     """RAPID's robconf cf1, cf4, cf6: the quadrants of axes 1, 4 and 6 (0 for 0 to 90 deg, -1 for -90 to 0, ...)."""
@@ -296,24 +374,28 @@ def plan_motion(kin, instr: str, q0: np.ndarray, target, speed, via=None, name: 
 
 class KinematicRobot:
     """The motion queue on a clock without physics (offline runs): the robot is exactly where the plan says, at
-    rest once its last motion's plan is over. Same interface as `robot.Robot` for queueing and asking."""
+    rest once its last motion's plan is over. Same interface as `robot.Robot` for queueing, asking and path
+    control (StopMove and the rest: the same PathClock)."""
 
     def __init__(self, kin, q: np.ndarray):
         self.kinematics = kin
         self._q = np.array(q, dtype=float)
         self._queue: MotionQueue | None = None
-        self._t0 = 0.0
+        self._clock = PathClock(0.0)
         self._handles = 0
         self._corner_failures: set[int] = set()
+        self._stored = None
+
+    def _tau(self, t: float) -> float:
+        return self._clock.tau(t)
 
     def q_at(self, t: float) -> np.ndarray:
         if self._queue is None:
             return self._q.copy()
-        tau = t - self._t0
-        return self._queue.q(min(tau, self._queue.end))
+        return self._queue.q(min(self._tau(t), self._queue.end))
 
     def busy(self, t: float) -> bool:
-        return self._queue is not None and t - self._t0 < self._queue.end
+        return self._queue is not None and self._tau(t) < self._queue.end
 
     def plan_start(self, t: float) -> np.ndarray:
         return self._queue.q_end if self.busy(t) else self.q_at(t)
@@ -325,9 +407,9 @@ class KinematicRobot:
             if last is not None and not last.zone.fine:  # it ran out of motions at a zone point: a stop point
                 self._corner_failures.add(last.handle)
             self._q = self.q_at(t)
-            self._queue, self._t0 = MotionQueue(traj.q_start), float(t)
+            self._queue, self._clock = MotionQueue(traj.q_start), PathClock(t)
         prev = self._queue.last
-        self._queue.add(traj, zone, t - self._t0, self._handles)
+        self._queue.add(traj, zone, self._tau(t), self._handles)
         if prev is not None and prev.corner_failure:
             self._corner_failures.add(prev.handle)
         return self._handles
@@ -337,23 +419,75 @@ class KinematicRobot:
 
     def start_time(self, handle: int) -> float | None:
         seg = self._segment(handle)
-        return None if seg is None else self._t0 + seg.start
+        return None if seg is None else self._clock.t_of(seg.start)
 
     def end_time(self, handle: int) -> float | None:
         seg = self._segment(handle)
-        return None if seg is None else self._t0 + seg.end
+        return None if seg is None else self._clock.t_of(seg.end)
 
     def ready_time(self, handle: int) -> float | None:
         seg = self._segment(handle)
-        return None if seg is None else self._t0 + seg.ready
+        return None if seg is None else self._clock.t_of(seg.ready)
 
     def ready(self, handle: int, t: float) -> bool:
-        at = self.ready_time(handle)
-        return at is None or t >= at - 1e-9
+        seg = self._segment(handle)
+        return seg is None or self._tau(t) >= seg.ready - 1e-9
 
     def done(self, handle: int, t: float) -> bool:
-        at = self.end_time(handle)
-        return at is None or t >= at - 1e-9
+        seg = self._segment(handle)
+        return seg is None or self._tau(t) >= seg.end - 1e-9
 
     def corner_failure(self, handle: int) -> bool:
         return handle in self._corner_failures
+
+    # -- path control, as robot.Robot's --------------------------------------------------------------------
+    def stop_path(self, t: float, quick: bool = False, at_end: bool = False) -> None:
+        if not self.busy(t):
+            return
+        tau = self._tau(t)
+        if at_end:
+            seg = next((s for s in self._queue.segments if s.start <= tau < s.end), None)
+            self._clock.stop(self._clock.t_of(seg.end) if seg is not None else t, 0.0)
+        else:
+            self._clock.stop(t, stop_ramp(self.kinematics, self._queue.state(tau)[1], quick))
+
+    def path_standing(self, t: float) -> bool:
+        return not self.busy(t) or (self._clock.stopping and self._clock.rate(t) == 0.0)
+
+    def stand_time(self, t: float) -> float | None:
+        """When the path will stand (t if it does or the robot is idle), None if not stopping."""
+        if self.path_standing(t):
+            return t
+        if self._clock is not None and self._clock.stopping:
+            return self._clock.t_a + self._clock.ramp
+        return None
+
+    def start_path(self, t: float) -> None:
+        if self._queue is not None and self._clock.stopping:
+            self._clock.start(t, stop_ramp(self.kinematics, self._queue.state(self._tau(t))[1], False))
+
+    def _stand(self, t: float) -> np.ndarray:
+        q = self.q_at(t)
+        self._q, self._queue, self._clock = q, None, PathClock(t)
+        return q
+
+    def clear_path(self, t: float) -> None:
+        self._stand(t)
+
+    def store_path(self, t: float) -> None:
+        stored = (self._queue, self._clock)
+        self._stored = (*stored, self._stand(t))
+
+    def restore_path(self, t: float) -> None:
+        from .errors import MotionError
+
+        if self._stored is None:
+            raise MotionError("RestoPath", "no path is stored (StorePath first)")
+        queue, clock, stand = self._stored
+        self._stored = None
+        off = self.kinematics.fk(self.q_at(t)).distance(self.kinematics.fk(stand))
+        if queue is not None and off > REGAIN_DISTANCE:
+            raise MotionError("RestoPath", f"the robot is {off * 1000:.1f} mm from where the stored path stands "
+                                           f"(at most {REGAIN_DISTANCE * 1000:g} mm): move it back there first")
+        if queue is not None:
+            self._queue, self._clock = queue, clock

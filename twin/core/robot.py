@@ -22,7 +22,7 @@ from .errors import MotionError
 from .geometry import Pose
 from .kinematics import ARM_JOINTS, ArmKinematics
 from .motion import Trajectory
-from .planner import FINE, MotionQueue, Zone
+from .planner import FINE, REGAIN_DISTANCE, MotionQueue, PathClock, Zone, stop_ramp
 
 
 class Robot:
@@ -56,7 +56,8 @@ class Robot:
         self._corner_failures: set[int] = set()  # zone points that became stop points (their next motion late)
         #: why the last motion ended without arriving (e.g. blocked by a collision), else None
         self.fault: str | None = None
-        self._t0: float | None = 0.0
+        self._clock: PathClock | None = PathClock(0.0)  # the motions' time (None: from the next update)
+        self._stored = None  # StorePath: the stopped path and its clock, while a temporary path runs
         self._end_tcp: Pose | None = None
         self._settled = True
         self._held = None
@@ -134,20 +135,20 @@ class Robot:
         started while another runs begins from standstill). Returns the motion's handle.
         """
         self._queue = MotionQueue(trajectory.q_start)
-        self._t0 = None if t is None else float(t)
+        self._clock = None if t is None else PathClock(t)
         return self._append(trajectory, FINE, 0.0)
 
     def queue(self, trajectory: Trajectory, zone: Zone, t: float) -> int:
         """Append `trajectory` (planned from `plan_start()`) to the motions under way at simulated time t: it
         starts when the last one ends, or blends out of its zone (planner.py). Returns the motion's handle."""
-        if self._queue is None or self._t0 is None or not self.busy(t):
+        if self._queue is None or self._clock is None or not self.busy(t):
             last = self._queue.last if self._queue is not None else None
             if last is not None and not last.zone.fine:  # it ran out of motions at a zone point: a stop point
                 self._corner_failures.add(last.handle)
             self._queue = MotionQueue(trajectory.q_start)
-            self._t0 = float(t)
+            self._clock = PathClock(t)
             return self._append(trajectory, zone, 0.0)
-        return self._append(trajectory, zone, t - self._t0)
+        return self._append(trajectory, zone, self._clock.tau(t))
 
     def _append(self, trajectory: Trajectory, zone: Zone, now: float) -> int:
         self._handles += 1
@@ -169,7 +170,7 @@ class Robot:
     def ready(self, handle: int, t: float) -> bool:
         """May the program go on past motion `handle`: a zone point's TCP in its largest zone (planner.py)?"""
         seg = self._segment(handle)
-        return seg is None or (self._t0 is not None and t - self._t0 >= seg.ready - 1e-9)
+        return seg is None or (self._clock is not None and self._clock.tau(t) >= seg.ready - 1e-9)
 
     def done(self, handle: int, t: float) -> bool:
         """Is motion `handle` over: the robot in position at its end, or gone on into the next motion?"""
@@ -178,7 +179,7 @@ class Robot:
             return True
         if seg is self._queue.last:
             return not self.busy(t)
-        return self._t0 is not None and t - self._t0 >= seg.end
+        return self._clock is not None and self._clock.tau(t) >= seg.end
 
     def corner_failure(self, handle: int) -> bool:
         """Did zone point `handle` become a stop point because its next motion came too late?"""
@@ -187,16 +188,79 @@ class Robot:
     def ready_time(self, handle: int) -> float | None:
         """The simulated time the program may go on past motion `handle` (`ready`), None if unknown."""
         seg = self._segment(handle)
-        return None if seg is None or self._t0 is None else self._t0 + seg.ready
+        return None if seg is None or self._clock is None else self._clock.t_of(seg.ready)
 
     def end_time(self, handle: int) -> float | None:
         """The simulated time motion `handle`'s plan ends, None if unknown."""
         seg = self._segment(handle)
-        return None if seg is None or self._t0 is None else self._t0 + seg.end
+        return None if seg is None or self._clock is None else self._clock.t_of(seg.end)
 
     def stop(self) -> None:
         """Stop following the trajectory and hold where the arm is now."""
         self._traj, self._queue, self._settled, self._hold = None, None, True, self.q
+
+    # -- path control (RAPID StopMove, StartMove, ClearPath, StorePath, RestoPath) ---------------------------
+    def stop_path(self, t: float, quick: bool = False, at_end: bool = False) -> None:
+        """StopMove: decelerate on the planned path and stand (planner.PathClock; `quick`: at the axes' full
+        acceleration limits, else half). `at_end`: stand at the end of the motion under way instead."""
+        if self._queue is None or self._clock is None or not self.busy(t):
+            return
+        tau = self._clock.tau(t)
+        if at_end:
+            seg = next((s for s in self._queue.segments if s.start <= tau < s.end), None)
+            self._clock.stop(self._clock.t_of(seg.end) if seg is not None else t, 0.0)
+        else:
+            self._clock.stop(t, stop_ramp(self.kinematics, self._queue.state(tau)[1], quick))
+
+    def path_standing(self, t: float) -> bool:
+        """Is the robot standing still on its path (stopped by `stop_path`, the ramp over) or idle?"""
+        if self._queue is None or self._clock is None or not self.busy(t):
+            return True
+        return self._clock.stopping and self._clock.rate(t) == 0.0 and self._clock.tau(t) == self._clock.tau(t + 1.0)
+
+    def stand_time(self, t: float) -> float | None:
+        """When the path will stand (t if it does or the robot is idle), None if not stopping."""
+        if self.path_standing(t):
+            return t
+        if self._clock is not None and self._clock.stopping:
+            return self._clock.t_a + self._clock.ramp
+        return None
+
+    def start_path(self, t: float) -> None:
+        """StartMove: the rest of the stopped path, speeding up as it slowed down."""
+        if self._queue is not None and self._clock is not None and self._clock.stopping:
+            tau = self._clock.tau(t)
+            self._clock.start(t, stop_ramp(self.kinematics, self._queue.state(tau)[1], False))
+
+    def _stand(self, t: float) -> np.ndarray:
+        """Where the path stands at t (its planned joints), the robot then idle there with no path."""
+        q = self._queue.q(min(self._clock.tau(t), self._queue.end)) if self._queue is not None and self._clock else self.q
+        self._traj, self._queue, self._settled, self._hold, self._clock = None, None, True, q, PathClock(t)
+        return q
+
+    def clear_path(self, t: float) -> None:
+        """ClearPath: the motions handed over and not yet done are dropped (done, as far as the program is
+        concerned); the robot holds where its path stands."""
+        self._stand(t)
+
+    def store_path(self, t: float) -> None:
+        """StorePath: keep the (standing) path aside; new motions run from where it stands until `restore_path`."""
+        stored = (self._queue, self._clock, self._traj, self._end_tcp)
+        self._stored = (*stored, self._stand(t))
+
+    def restore_path(self, t: float) -> None:
+        """RestoPath: the stored path back, standing (StartMove resumes it). MotionError if none is stored."""
+        if self._stored is None:
+            raise MotionError("RestoPath", "no path is stored (StorePath first)")
+        self._queue, self._clock, self._traj, self._end_tcp, stand = self._stored
+        self._stored = None
+        self._settled = self._traj is None
+        if self.kinematics is not None and self._traj is not None:
+            off = self.kinematics.fk(self.q).distance(self.kinematics.fk(stand))
+            if off > REGAIN_DISTANCE:
+                self._traj, self._queue, self._settled, self._hold = None, None, True, self.q
+                raise MotionError("RestoPath", f"the robot is {off * 1000:.1f} mm from where the stored path stands "
+                                               f"(at most {REGAIN_DISTANCE * 1000:g} mm): move it back there first")
 
     def pause(self, paused: bool = True) -> None:
         """A robot stop (protective stop, feed hold): the arm holds where it is and a motion under way waits,
@@ -220,9 +284,9 @@ class Robot:
         """
         if self._traj is None or self._settled:
             return False
-        if self._t0 is None:
+        if self._clock is None:
             return True
-        tau = t - self._t0
+        tau = self._clock.tau(t)
         end = self._queue.end
         if tau < end:
             return True
@@ -246,23 +310,26 @@ class Robot:
         """Command the arm for the step from t to t + dt (call once per step, before physics steps)."""
         traj = self._traj
         if self._paused is not None:
-            if traj is not None and self._t0 is not None:
-                self._t0 += self.dt  # the motion's clock stands still
+            if traj is not None and self._clock is not None:
+                self._clock.shift(self.dt)  # the motion's clock stands still
             self._command(self._paused, np.zeros(len(self.joints)))
             return
         if traj is None:
             self._command_hold(self._hold)
             return
-        if self._t0 is None:
-            self._t0 = float(t)
-        tau = t - self._t0 + self.dt
+        if self._clock is None:
+            self._clock = PathClock(t)
+        tau, rate = self._clock.tau(t + self.dt), self._clock.rate(t + self.dt)
         queue = self._queue
         if tau >= queue.end:
             if self._hold_for is not traj:
                 self._hold, self._hold_for = queue.q(queue.end), traj
             self._command_hold(self._hold)
-        else:
+        elif rate == 1.0:
             self._command(*queue.state(tau))
+        else:  # StopMove / StartMove: on the path, at the clock's rate
+            q, qd = queue.state(tau)
+            self._command(q, qd * rate)
 
     def _command_hold(self, q: np.ndarray) -> None:
         """Hold q: commanded once (the motors keep their command), not again at every substep."""
