@@ -71,9 +71,10 @@ def test_a_front_end_in_its_own_process_writes_as_one_in_process(tmp_path):
         assert step == expected["sim.step"]
         assert {k: v for k, v in values.items() if not k.startswith("sim.")} == \
                {k: v for k, v in expected.items() if not k.startswith("sim.")}
-    # every step reached the process, in order
+    # every step reached the process, in order, from step 0 (a process that missed the first ones would not pass)
     steps = seen["steps"]
-    assert sorted(set(steps)) == list(range(steps[0], 9)) and steps == sorted(steps)
+    assert sorted(set(steps)) == list(range(steps[0], 9)) and steps == sorted(steps), steps
+    assert steps[0] == 0  # from the first snapshot on: in lockstep nothing steps before the script asks
 
 
 def test_bench_adapter_runs_with_tiny_parameters():
