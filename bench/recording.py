@@ -6,7 +6,7 @@ In process, lockstep, the robot running its program: blocks of N steps without a
 alternately (so the machine's load hits both alike), for a Parquet and a CSV recording. The cost is the
 difference of the medians, the file's final write (at close) spread over the recorded steps, as a share of
 the step's own compute time (target: at most 10 %) and of the 12 ms real-time step. CPU time of the whole
-process: the writer thread's work counts (it shares the interpreter with the steps). Apart: what finishing
+process (every thread's work counts: it shares the interpreter with the steps). Apart: what finishing
 the file costs once the run stops (a Parquet recording is converted from its crash-safe stream), per step
 recorded.
 """
@@ -66,7 +66,7 @@ def main(argv: list[str]) -> int:
     runs = {fmt: lockstep_cost(args.steps, args.blocks, suffix) for fmt, suffix in (("Parquet", ".parquet"), ("CSV", ".csv"))}
     first = next(iter(runs.values()))
     print(f"ring_rig_plc, lockstep, in process: median of {args.blocks} blocks of {args.steps} steps "
-          f"({first['columns']} columns per row); CPU time of the whole process (the writer thread's included)")
+          f"({first['columns']} columns per row); CPU time of the whole process")
     print(f"{'':40}" + "".join(f"{k:>12}" for k in runs))
     for label, key in (("us per step, bare", "bare_us"), ("us per step, recording", "rec_us"),
                        ("recording cost, us per step", "cost_us"), ("file size, bytes per step", "bytes_per_row")):

@@ -200,7 +200,7 @@ class Observer:
         return fingers
 
     def raw(self, values: tuple | None = None) -> tuple:
-        """The state now as plain tuples: (step, time, values, poses flat (x y z qx qy qz qw per body), joints).
+        """The state now as plain sequences: (step, time, values, poses flat (x y z qx qy qz qw per body), joints).
 
         The cheap form a recorder keeps for every step; `frame()` makes a `Frame` of it. `values`: the
         signals' values in `scene.signals`' order when the caller has them already (a published snapshot).
@@ -243,7 +243,7 @@ class Observer:
                 have.update(zip(missing, (s[0] for s in pybullet.getJointStates(self._machine, missing,
                                                                                    physicsClientId=cid))))
             joints = tuple([have[j] for j in self._joint_indices])
-        return twin.step_count, twin.time, values, tuple(poses), joints
+        return twin.step_count, twin.time, values, poses, joints
 
     def frame(self, raw: tuple | None = None) -> Frame:
         step, t, values, poses, joints = raw if raw is not None else self.raw()

@@ -37,7 +37,10 @@ keeps every step.
 
 The recorder is a device of the twin (stepped with it, adding no signals), or, in a served cell, a
 subscriber of the exchange that takes the signals' values from the snapshot already published (`exchange`):
-the core imports nothing of it. See `python -m bench record` for what it costs a step.
+the core imports nothing of it. What a step costs it: the bodies' poses read from pybullet once (the joints
+and targets the step read itself are taken from the twin, `Twin.step_readings`), the row kept as the tuples
+read; a group's numbers are packed into arrays at once when it is written, and a CSV number is formatted once
+per run of equal values down its column. See `python -m bench record`.
 """
 from __future__ import annotations
 
@@ -100,10 +103,21 @@ class _Layout:
         kinds = [t for _, t in self.columns[2:2 + len(scene.signals)]]
         self.index = {k: [i for i, t in enumerate(kinds) if t == k] for k in self.KINDS}
         self.n_poses, self.n_joints = 7 * len(scene.bodies), len(scene.joints)
-        codes = {"float64": "d", "bool": "?", "int64": "q", "string": "x"}  # (strings are not packed)
-        self._pickers = [(k, operator.itemgetter(*self.index[k]), len(self.index[k]),
-                          struct.Struct(f"<{len(self.index[k])}{codes[k]}")) for k in self.KINDS if self.index[k]]
-        self._pack_poses, self._pack_joints = struct.Struct(f"<{self.n_poses}d"), struct.Struct(f"<{self.n_joints}d")
+        # a row's numbers packed by one `struct` call into one record (its numeric signals by kind, then the
+        # poses and joints) that a numpy structured dtype then reads as it is
+        codes = {"float64": "d", "bool": "?", "int64": "q"}
+        numeric = [k for k in ("float64", "bool", "int64") if self.index[k]]
+        order = [i for k in numeric for i in self.index[k]]
+        self._pick_numbers = operator.itemgetter(*order) if len(order) > 1 else (
+            (lambda v, i=order[0]: (v[i],)) if order else (lambda v: ()))
+        self._pick_strings = operator.itemgetter(*self.index["string"]) if len(self.index["string"]) > 1 else (
+            (lambda v, i=self.index["string"][0]: (v[i],)) if self.index["string"] else None)
+        self._row = struct.Struct("<" + "".join(f"{len(self.index[k])}{codes[k]}" for k in numeric)
+                                  + f"{self.n_poses + self.n_joints}d")
+        fields = [(k, self.DTYPES[k], (len(self.index[k]),)) for k in numeric]
+        fields += [("poses", self.DTYPES["float64"], (self.n_poses,)), ("joints", self.DTYPES["float64"], (self.n_joints,))]
+        self._record = np.dtype(fields)
+        assert self._record.itemsize == self._row.size
 
     def schema(self, pa, metadata: dict | None = None):
         types = {"float64": pa.float64(), "bool": pa.bool_(), "int64": pa.int64(), "string": pa.string()}
@@ -115,21 +129,18 @@ class _Layout:
 
     def blocks(self, group: "_Group") -> dict:
         """A group's rows as numpy blocks: step, time, one (rows, width) block per kind of signal, poses, joints.
-        (Each row's numbers packed by a `struct` into bytes numpy then takes as they are: a third of what
-        numpy's own conversion of a list of tuples costs.)"""
+        (Each row's numbers packed by one `struct` call into bytes numpy then reads as they are: a third of
+        what numpy's own conversion of a list of tuples costs.)"""
         n = group.n
+        pack, pick = self._row.pack, self._pick_numbers
+        data = b"".join([pack(*pick(v), *p, *j) for v, p, j in zip(group.values, group.poses, group.joints)])
+        records = np.frombuffer(data, self._record, n)
         out = {"step": np.array(group.steps, dtype=np.int64), "time": np.array(group.times, dtype=float)}
-        for kind, pick, width, packer in self._pickers:
-            picked = map(pick, group.values)
-            if kind == "string":
-                out[kind] = np.array(list(picked), dtype=object).reshape(n, width)
-                continue
-            pack = packer.pack
-            data = b"".join([pack(*v) for v in picked] if width > 1 else [pack(v) for v in picked])
-            out[kind] = np.frombuffer(data, self.DTYPES[kind]).reshape(n, width)
-        for key, width, packer in (("poses", self.n_poses, self._pack_poses), ("joints", self.n_joints, self._pack_joints)):
-            pack = packer.pack
-            out[key] = np.frombuffer(b"".join([pack(*v) for v in getattr(group, key)]), float).reshape(n, width)
+        for name in self._record.names:
+            out[name] = records[name].reshape(n, -1)
+        if self._pick_strings is not None:
+            out["string"] = np.array([pick for v in group.values for pick in self._pick_strings(v)],
+                                     dtype=object).reshape(n, -1)
         return out
 
     def batch(self, pa, schema, group: "_Group"):
@@ -306,10 +317,11 @@ class Recorder(ObservingDevice):
         system call."""
         _write_all(self._fd, self._encode(rows))
 
-    def _encode(self, rows: _Group) -> bytes:
+    def _encode(self, rows: _Group):
+        """The group as the bytes to write (or a buffer holding them)."""
         pa = self._pa
         if self._parquet:  # one stream message: what the stream writer would put after the schema
-            data = self.layout.batch(pa, self._schema, rows).serialize().to_pybytes()
+            data = memoryview(self.layout.batch(pa, self._schema, rows).serialize())
         elif pa is not None:
             data = _csv_lines(pa, self.layout, rows)
         else:

@@ -244,14 +244,11 @@ class Twin:
         step, arm, grip, poses = self._read
         if step != self.step_count or not step:
             return None
-        ids, q = [], []
-        if arm is not None:
-            ids += self.robot.joints
-            q += arm
-        if grip is not None:
-            ids += self.gripper.joint_ids
-            q += grip
-        return ids, q, [uid for uid, *_ in self._target_keys], poses
+        ids = self._read_ids
+        if ids is None:
+            ids = self._read_ids = ((self.robot.joints if arm is not None else [])
+                                    + (self.gripper.joint_ids if grip is not None else []))
+        return ids, (arm or []) + (grip or []), self._target_ids, poses
 
     def _index_outputs(self) -> None:
         """The output names published at every step, spelled out once (not formatted anew at every step)."""
@@ -264,6 +261,8 @@ class Twin:
                             if self.robot is not None else [])
         self._target_keys = [(self.world.body_ids[t.name], f"{t.name}.x", f"{t.name}.y", f"{t.name}.z")
                              for t in self.station.targets]
+        self._target_ids = [uid for uid, *_ in self._target_keys]
+        self._read_ids: list[int] | None = None  # the joints `step_readings` gives, once known
 
     # -- robot motion -----------------------------------------------------------------------------
     def target(self, name: str):
