@@ -7,6 +7,7 @@ running simulation, as when a physics server dies. Steps are asked for through `
 from __future__ import annotations
 
 import asyncio
+from concurrent.futures import ThreadPoolExecutor
 
 from plc_client.events import EventLog
 from tests.conftest import STATIONS
@@ -47,8 +48,9 @@ def test_a_failing_step_is_one_fault_event_at_the_last_completed_steps_time(tmp_
             stop.set()
             await served
 
-    try:
-        asyncio.run(run())
+    try:  # in a thread of its own: a loop some other test left running in this one cannot get in the way
+        with ThreadPoolExecutor(1) as pool:
+            pool.submit(asyncio.run, run()).result()
     finally:
         events.close()
         cell.close()
