@@ -27,10 +27,10 @@ the link: `plc_client.link.LinkFaults`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from .core.errors import SignalError, TwinError
-from .core.signals import FLOAT, INPUT
+from .core.signals import BOOL, ENUM, FLOAT, INPUT, INT
 from .core.device import ObservingDevice
 
 EPS = 1e-9
@@ -206,8 +206,18 @@ class ReadingStuck(Fault):
     value: object = None
 
     def check(self, twin) -> None:
+        """A stuck value is one the reading could show: checked as a write to it would be (`SignalSpec.check`:
+        type, range; an enumeration's index becomes its text), so a wrong one is refused here, naming it."""
         super().check(twin)
-        _check_output(self, twin, self.signal)
+        spec = _check_output(self, twin, self.signal)
+        if self.value is not None:
+            value = self.value
+            if isinstance(value, float) and spec.type in (INT, ENUM, BOOL) and value.is_integer():
+                value = int(value)  # a whole number read from a file as a float
+            try:
+                self.value = replace(spec, direction=INPUT).check(value)
+            except SignalError as exc:
+                raise FaultError(f"{self.label()}: value: {exc}") from None
 
     def label(self) -> str:
         return f"ReadingStuck {self.signal}"

@@ -51,3 +51,26 @@ def test_a_link_loss_between_the_check_and_the_server(tmp_path):
         assert client.get("L2.actual") < frozen - 3.0  # the finger moved on; the PLC still reads the old value
         plc.run(seconds=0.2)  # back at 0.6 s: the latest output is written at once
         assert client.get("L2") == pytest.approx(320.0) and plc.image[LINK_OK]
+
+
+@pytest.mark.parametrize("signal, value, reason", [
+    ("GrippedPart", "7", r"faults.toml: faults: ReadingStuck GrippedPart: value: .*one of '', 'ring'"),
+    ("L2.force", "-5.0", r"faults: ReadingStuck L2.force: value: .*-5.*outside the range 0"),
+    ("doGripped", "2", r"faults: ReadingStuck doGripped: value: .*a bool"),
+])
+def test_a_stuck_reading_no_signal_could_show_is_refused_when_the_file_is_loaded(tmp_path, signal, value, reason):
+    """The one validation of values (`SignalSpec.check`) holds for a stuck reading too: a value the reading could
+    never show (an enumeration's index past its choices, a force below 0, a bool of 2) is refused at load, naming
+    the fault and the signal, instead of reaching the PLC as something else (index 7 read as 'none')."""
+    from twin.core import Twin
+    from twin_app.campaign.faultfile import load_fault_file
+    from twin_app.campaign.spec import SpecError
+
+    faults = tmp_path / "faults.toml"
+    faults.write_text(f'[faults.bad]\nkind = "reading_stuck"\nsignal = "{signal}"\nvalue = {value}\n')
+    with Twin.from_station(BENCH) as twin:
+        with pytest.raises(SpecError, match=reason):
+            load_fault_file(faults, twin)
+        faults.write_text('[faults.ok]\nkind = "reading_stuck"\nsignal = "GrippedPart"\nvalue = 1\n')
+        (stuck,) = load_fault_file(faults, twin)
+        assert stuck.value == "ring"  # index 1: the first target, as the Modbus map numbers them
