@@ -32,7 +32,7 @@ one of them text) costs the simulation's process 26 us of CPU through a socket p
 600 B): 0.2 % and 0.1 % of a 12 ms step, the same for the step. Shared memory keeps only the newest snapshot
 (a reader that looks late misses a step, and OPC UA must publish every step), holds no text, makes the
 reader poll, and still needs a second channel, ordered with the snapshots, for writes and `Sim.Advance`. A
-socket pair carries every step in order, text included, wakes the reader only when there is something to
+socket carries every step in order, text included, wakes the reader only when there is something to
 read, and is the write channel too; the adapter sends only the values that changed, cheaper still.
 """
 from __future__ import annotations
@@ -43,9 +43,11 @@ import logging
 import multiprocessing
 import os
 import pickle
+import shutil
 import socket
 import struct
 import sys
+import tempfile
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -118,6 +120,9 @@ class FrontEndProcess:
         self._reader_task: asyncio.Task | None = None
         self._unsubscribe = None
         self._sent: dict[str, object] = {}
+        self._accepted = 0  # write batches of the process the exchange accepted
+        self._applied = 0  # ... and a step has applied (sent with every snapshot)
+        self._last_step = -1
         self._waiting: list[tuple[int, int]] = []  # Sim.Advance: (target step, request id)
         self._started: asyncio.Future | None = None
         self._bye: asyncio.Future | None = None
@@ -129,12 +134,27 @@ class FrontEndProcess:
         loop = asyncio.get_running_loop()
         if self.local is not None:
             self.local.start(cell, lambda payload: self._send(("local", payload)))
-        mine, theirs = socket.socketpair()
-        ctx = multiprocessing.get_context("spawn")  # a clean interpreter: no pybullet, no event loop copied
-        self.process = ctx.Process(target=child_main, name=f"twin-{self.name}", daemon=True,
-                                   args=(self.target, theirs))
-        self.process.start()
-        theirs.close()
+        # the process connects to a socket only this user can reach (passing a socket to a spawned process
+        # would start a thread here to hand it over)
+        folder = tempfile.mkdtemp(prefix="twin-frontend-")
+        address = os.path.join(folder, "cell")
+        listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        try:
+            listener.bind(address)
+            listener.listen(1)
+            listener.setblocking(False)
+            ctx = multiprocessing.get_context("spawn")  # a clean interpreter: no pybullet, no event loop copied
+            self.process = ctx.Process(target=child_main, name=f"twin-{self.name}", daemon=True,
+                                       args=(self.target, address))
+            self.process.start()
+            try:
+                mine, _ = await asyncio.wait_for(loop.sock_accept(listener), self.start_timeout)
+            except asyncio.TimeoutError:
+                await self._end()
+                raise TwinError(f"{self.name}: its process did not start within {self.start_timeout:g} s") from None
+        finally:
+            listener.close()
+            shutil.rmtree(folder, ignore_errors=True)
         reader, self._writer = await asyncio.open_connection(sock=mine)
         self._started, self._bye = loop.create_future(), loop.create_future()
         ex, twin = cell.exchange, cell.exchange.twin
@@ -183,15 +203,15 @@ class FrontEndProcess:
         if self._reader_task is not None:
             self._reader_task.cancel()
             await asyncio.gather(self._reader_task, return_exceptions=True)
-        if self.process is not None:
-            await asyncio.get_running_loop().run_in_executor(None, self._join)
-        self._fail_waiting()
-
-    def _join(self) -> None:
-        self.process.join(5.0)
-        if self.process.is_alive():
-            self.process.terminate()
+        if self.process is not None:  # no thread to wait in: look every 20 ms
+            for _ in range(250):
+                if not self.process.is_alive():
+                    break
+                await asyncio.sleep(0.02)
+            if self.process.is_alive():
+                self.process.terminate()
             self.process.join(2.0)
+        self._fail_waiting()
 
     # -- cell -> process ---------------------------------------------------------------------------
     def _send(self, msg) -> None:
@@ -211,7 +231,9 @@ class FrontEndProcess:
         changed = {k: v for k, v in snapshot.values.items() if k not in sent or sent[k] != v
                    or type(sent[k]) is not type(v)}
         sent.update(changed)
-        self._send(("snap", snapshot.step, snapshot.time, changed))
+        if snapshot.step != self._last_step:  # a step applied every batch accepted before it
+            self._last_step, self._applied = snapshot.step, self._accepted
+        self._send(("snap", snapshot.step, snapshot.time, changed, self._applied))
 
     def _on_snapshot(self, snapshot) -> None:
         self._send_snapshot(snapshot)
@@ -263,6 +285,7 @@ class FrontEndProcess:
             _, i, writes = msg
             try:
                 batch = self.cell.exchange.submit(writes)
+                self._accepted += 1
                 reply = ("ok", batch)
             except TwinError as exc:
                 reply = _error_reply(exc)
@@ -287,7 +310,7 @@ class FrontEndProcess:
             if self.local is not None:
                 self.local.on_message(msg[1])
         elif kind == "log":
-            self.cell.log(f"{self.name}: {msg[2]}", msg[1])
+            self.cell.log(msg[2], msg[1])
         elif kind == "bye":
             self.requests = msg[1]
             if not self._bye.done():
@@ -340,6 +363,7 @@ class Remote:
         self.signals = hello["signals"]
         self._spec = {s.name: s for s in self.signals}
         self.snapshot = RemoteSnapshot(0, 0.0, MappingProxyType({}))
+        self.applied = 0  # this process's write batches (accepted by `submit`) that the snapshot's step applied
         self._values: dict[str, object] = {}
         self._writer = writer
         self._subscribers: list[Callable[[RemoteSnapshot], None]] = []
@@ -389,7 +413,7 @@ class Remote:
         self._local.append(fn)
 
     def log(self, text: str, level: int = logging.WARNING) -> None:
-        """A line in the simulation's log."""
+        """A line in the simulation's log (as it is: say whose it is)."""
         self._send(("log", level, text))
 
     async def _ask(self, kind: str, arg):
@@ -404,8 +428,9 @@ class Remote:
         if not self._writer.is_closing():
             self._writer.write(_frame(msg))
 
-    def _snap(self, step: int, time: float, changed: dict) -> None:
+    def _snap(self, step: int, time: float, changed: dict, applied: int) -> None:
         self._values.update(changed)
+        self.applied = applied
         self.snapshot = RemoteSnapshot(step, time, MappingProxyType(dict(self._values)))
         for f in tuple(self._subscribers):
             f(self.snapshot)
@@ -426,8 +451,10 @@ class Remote:
         self._replies.clear()
 
 
-def child_main(target: str, sock: socket.socket) -> None:
+def child_main(target: str, address: str) -> None:
     """The front end's process: run the front end `target` names until the cell says stop (or is gone)."""
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    sock.connect(address)
     try:
         asyncio.run(_child(target, sock))
     except KeyboardInterrupt:

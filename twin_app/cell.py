@@ -36,8 +36,10 @@ The front-end contract (Modbus today; OPC UA and the web view plug in the same w
    the next step, together and in arrival order. `exchange.written(name)` reads an input back at once.
 4. Time is the runner's: front ends never step the cell. In lockstep, writing N to `sim.advance` (or
    `cell.exchange.submit([("sim.advance", N)])`) runs N more steps; `sim.advance` reads the steps left.
-5. Everything runs on one asyncio event loop, so a callback or a request handler never sees a step half
-   done. Front ends use `cell.station` (names, units) and, for geometry only, `cell.twin` (never to
+5. The concurrency rule (`twin.frontend_process`): the simulation and its Modbus front end run on one asyncio
+   event loop in one process, so a callback or a request handler never sees a step half done; every other
+   front end (OPC UA, the live page) runs in a process of its own behind `FrontEndProcess`, fed the
+   snapshots and handing its writes back through the exchange. Front ends use `cell.station` (names, units) and, for geometry only, `cell.twin` (never to
    step or write it).
 
 In process (tests, the in-process demo, a campaign's scenario), a cell is also stepped directly:

@@ -278,9 +278,11 @@ def test_sim_advance_reproduces_a_modbus_lockstep_run_bit_for_bit(rmap):
 class Collector:
     def __init__(self):
         self.changes: list[tuple[float, str, object]] = []
+        self.stamps: list[tuple[object, object]] = []  # (value, SourceTimestamp)
 
     def datachange_notification(self, n, val, data):
         self.changes.append((time.monotonic(), n.nodeid.Identifier, val))
+        self.stamps.append((val, data.monitored_item.Value.SourceTimestamp))
 
 
 def test_a_subscription_sees_every_step_even_when_it_publishes_slower(lockstep):
@@ -302,11 +304,16 @@ def test_a_subscription_sees_every_step_even_when_it_publishes_slower(lockstep):
             await advance(c, ns, 60)
             await asyncio.sleep(0.5)
             await sub.delete()
-            return first, col.changes
+            dt_us = await node(c, ns, "sim.dt_us").read_value()
+            return first, col.changes, col.stamps, dt_us
 
-    first, changes = run(main())
+    first, changes, stamps, dt_us = run(main())
     values = [v for _, _, v in changes]
     assert values[-61:] == list(range(first, first + 61))  # the initial value, then every step's
+    # SourceTimestamps in simulated time: step k is k steps of the station's dt after step `first`, to the
+    # microsecond (OPC UA's DateTime counts 100 ns), however long the 60 steps took on the wall clock
+    t0 = dict(stamps)[first]
+    assert all(round((ts - t0).total_seconds() * 1e6) == (step - first) * dt_us for step, ts in stamps[-61:])
 
 
 def test_intervals_below_the_step_are_revised_to_the_step(lockstep):

@@ -13,10 +13,7 @@
 from __future__ import annotations
 
 import argparse
-import asyncio
-import gc
 import logging
-import sys
 from pathlib import Path
 
 from twin.cli_args import tcp_port
@@ -24,7 +21,6 @@ from twin.cli_args import tcp_port
 from .security import POLICIES, Account, Security, SecurityError
 
 DEFAULT_PORT = 4840
-SWITCH_INTERVAL = 0.0005  # s, see OpcUaFrontEnd.start
 
 
 def _policies(text: str) -> tuple[str, ...]:
@@ -84,26 +80,6 @@ def check_arguments(args) -> str | None:
     return None
 
 
-async def start_opcua(link, *, host: str, port: int, security: Security):
-    """Build the station's address space and serve it on the cell behind `link` (a `CellLink` on its exchange);
-    run in the server's loop, then `link.attach(server)` in the cell's.
-
-    Returns the started `OpcUaServer`; OSError when the port cannot be bound, SecurityError for bad options."""
-    from .address_space import build_address_space
-    from .server import OpcUaServer
-
-    twin = link.twin
-    space = build_address_space(link.signals(), twin.station.name)
-    server = OpcUaServer(space, step_s=twin.dt, submit=link.submit, advance=link.advance, security=security,
-                         on_request=link.feed if link.watchdog is not None else None, clock_requests=link.lockstep)
-    try:
-        await server.start(host, port)
-    except BaseException:
-        await server.close()
-        raise
-    return server
-
-
 def options_from(args) -> dict | None:
     """`serve`'s keyword `opcua` from the parsed command line (None without --opcua)."""
     if getattr(args, "opcua", None) is None:
@@ -121,6 +97,11 @@ class OneLineLog(logging.Handler):
     SAID = {"Exception raised while processing message from client": "a client's message could not be processed "
                                                                       "(its connection is closed)"}
 
+    def __init__(self, sink=None):
+        """`sink(text, level)`: where the lines go (default the `twin.serve` logger of this process)."""
+        super().__init__()
+        self.sink = sink
+
     def emit(self, record: logging.LogRecord) -> None:
         try:
             text = record.getMessage()
@@ -133,22 +114,28 @@ class OneLineLog(logging.Handler):
         if exc is not None:
             why = str(exc).splitlines()[0] if str(exc) else ""
             text = f"{text}: {type(exc).__name__}" + (f": {why}" if why else "")
-        logging.getLogger("twin.serve").log(min(record.levelno, logging.WARNING), f"OPC UA: {text}")
+        level = min(record.levelno, logging.WARNING)
+        if self.sink is not None:
+            self.sink(f"OPC UA: {text}", level)
+        else:
+            logging.getLogger("twin.serve").log(level, f"OPC UA: {text}")
 
 
-def route_opcua_log() -> None:
-    """Send the loggers of asyncua and of this front end through `OneLineLog` (once)."""
+def route_opcua_log(sink=None) -> None:
+    """Send the loggers of asyncua and of this front end through `OneLineLog` (once; `sink`: see there)."""
     for name in ("asyncua.server", "asyncua.common", "asyncua.crypto", "twin.opcua"):  # not a client's (asyncua.client)
         lg = logging.getLogger(name)
         if not any(isinstance(h, OneLineLog) for h in lg.handlers):
-            lg.addHandler(OneLineLog())
+            lg.addHandler(OneLineLog(sink))
         lg.propagate = False
         if lg.level == logging.NOTSET:
             lg.setLevel(logging.WARNING)
 
 
 class OpcUaFrontEnd:
-    """OPC UA as a front end of a cell (the contract: `twin_app.cell`): `OpcUaFrontEnd.from_args(args)`."""
+    """OPC UA as a front end of a cell (the contract: `twin_app.cell`): `OpcUaFrontEnd.from_args(args)`. The server
+    runs in a process of its own behind the front-end adapter (`twin.frontend_process`; its side:
+    `twin.opcua.cell_link`)."""
 
     name = "opcua"
 
@@ -157,11 +144,7 @@ class OpcUaFrontEnd:
         """`watchdog`: the comm-loss watchdog's seconds (`twin serve --watchdog S`; 0: off; None: the
         station's), which every request of an OPC UA session feeds."""
         self.host, self.port, self.security, self.watchdog = host, port, security or Security(), watchdog
-        self.link = None
-        self.server = None
-        self.thread = None
-        self._switch_interval = sys.getswitchinterval()
-        self._frozen = False
+        self.process = None
 
     @classmethod
     def from_args(cls, args) -> "OpcUaFrontEnd | None":
@@ -169,69 +152,36 @@ class OpcUaFrontEnd:
         options = options_from(args)
         return None if options is None else cls(**options)
 
+    @property
+    def requests(self) -> int:
+        return 0 if self.process is None else self.process.requests
+
     async def start(self, cell) -> list[str]:
         """Raises OSError when the port cannot be bound, TwinError for bad security options."""
-        from twin.core.errors import TwinError
+        from twin.frontend_process import FrontEndProcess
 
-        from .cell_link import CellLink, ServerThread
-
-        route_opcua_log()
         watchdog = getattr(cell, "watchdog", None)
         if watchdog is not None:
             if self.watchdog is not None:
                 cell.set_watchdog_timeout(self.watchdog)
             if hasattr(cell, "log"):
                 watchdog.log = lambda text: cell.log(text, logging.WARNING)
-        # the asyncua server in a thread of its own: a request never waits behind a step, nor a step behind it
-        self.thread = ServerThread()
-        self.link = CellLink(cell.exchange, cell.runner, watchdog=watchdog, cell_loop=asyncio.get_running_loop(),
-                             server_loop=self.thread.loop)
-        # a thread waiting for the interpreter gets it after this long (default 5 ms): a request that comes
-        # while the simulation steps waits at most about this (pybullet's calls excepted)
-        self._switch_interval = sys.getswitchinterval()
-        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
+        timeout = (watchdog.timeout or 0) if watchdog is not None else 0
+        self.process = FrontEndProcess(self.name, "twin.opcua.cell_link:process", {
+            "host": self.host, "port": self.port, "security": self.security, "watchdog": timeout})
         try:
-            self.server = await self.thread.run(start_opcua(self.link, host=self.host, port=self.port,
-                                                            security=self.security))
-        except BaseException as exc:
-            self.thread.stop()
-            sys.setswitchinterval(self._switch_interval)
-            if isinstance(exc, OSError):
-                raise OSError(f"OPC UA cannot listen on {self.host}:{self.port}: {exc.strerror or exc}") from None
-            if isinstance(exc, SecurityError):
-                raise TwinError(f"OPC UA security: {exc}") from None
+            return await self.process.start(cell)
+        except OSError as exc:
+            self.process = None
+            raise OSError(f"OPC UA cannot listen on {self.host}:{self.port}: {exc}") from None
+        except TwinError:
+            self.process = None
             raise
-        self.link.attach(self.server)
-        # the address space (tens of thousands of asyncua objects) lives as long as the server: keep it out of
-        # the collector's full passes, which would otherwise stop the simulation for milliseconds at a time
-        gc.collect()
-        gc.freeze()
-        self._frozen = True
-        policies = ", ".join(self.security.policies_for(self.host))
-        users = f", {len(self.security.accounts)} account(s), no anonymous" if self.security.accounts else ", anonymous"
-        fed = f", feeds the watchdog ({watchdog.timeout:g} s)" if watchdog is not None and watchdog.timeout else ""
-        return [f"OPC UA: namespace {self.server.space.namespace_uri} (ns={self.server.ns}), {len(self.server.space)} "
-                f"variables, security {policies}{users}{fed}", f"OPC UA listening on {self.server.endpoint}"]
 
     def endpoints(self) -> list[dict]:
         """Where it listens, for the `ready` event (`twin.events`)."""
-        if self.server is None:
-            return []
-        from urllib.parse import urlsplit
-
-        url = urlsplit(self.server.endpoint)
-        return [{"name": self.name, "protocol": "opc.tcp", "host": self.host, "port": url.port, "url": self.server.endpoint}]
+        return [] if self.process is None else self.process.endpoints()
 
     async def close(self) -> None:
-        if self.link is not None:
-            self.link.detach()
-        if self.thread is not None:
-            try:
-                if self.server is not None:
-                    await asyncio.wait_for(self.thread.run(self.server.close()), 10)
-            finally:
-                self.thread.stop()
-                sys.setswitchinterval(self._switch_interval)
-                if self._frozen:  # in process (a test, an application): back to the collector as before
-                    gc.unfreeze()
-                    self._frozen = False
+        if self.process is not None:
+            await self.process.close()

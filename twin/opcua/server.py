@@ -3,9 +3,12 @@
 Like the Modbus server, it answers from what the cell published after the last completed step and hands
 validated writes to the cell, which applies them at the start of the next step:
 
-- `publish(values, applied)` (called for every step's snapshot, in the server's own loop: see
-  `cell_link`) writes every value that changed into the address space, one DataValue per variable,
-  timestamped now. Each change is queued at once for every monitored item on that variable, so a
+- `publish(values, applied, t)` (called for every step's snapshot, in the OPC UA process's loop: see
+  `cell_link`) writes every value that changed into the address space, one DataValue per variable. Its
+  SourceTimestamp is the step's simulated time on the server's clock: the UTC wall time when the server
+  started, less the simulated time then, plus the step's simulated seconds (`start_clock`). In real time at
+  speed 1 that is the step's due time on the wall clock; in lockstep, timestamps advance by exactly one step
+  per step however fast the steps run. ServerTimestamp is the wall clock when the value was published. Each change is queued at once for every monitored item on that variable, so a
   subscription sees the value of every step, even one that lasts a single step.
 - A client's write of a signal goes through `_write_signal`: outputs are read-only (BadNotWritable), a
   Variant of another type is BadTypeMismatch, a value outside the signal's range (or NaN, or a text that
@@ -29,7 +32,7 @@ import logging
 import math
 import socket
 from collections.abc import Awaitable, Callable, Mapping, Sequence
-from datetime import datetime, timezone
+from datetime import datetime, timedelta, timezone
 
 from asyncua import Server, ua
 from asyncua.ua.ua_binary import nodeid_from_binary, struct_from_binary
@@ -55,7 +58,7 @@ MAX_ADVANCE = 2**32 - 1
 QUEUE_CAP = 10_000  # the largest queue a monitored item is given
 FASTEST_STEP_MS = 0.5  # wall time of a step at the fastest a cell runs (lockstep, --speed): sizes the queues
 
-Submit = Callable[[Sequence[tuple[Variable, object]]], str | None]  # -> None, or the name of a Bad status code
+Submit = Callable[[Sequence[tuple[Variable, object]]], Awaitable[str | None]]  # -> None, or a Bad status code's name
 Advance = Callable[[int], Awaitable[int]]  # lockstep: run n steps, return the step count when done
 OnRequest = Callable[[str, bool], None]  # (source, clock_only): a session's request came (the comm-loss watchdog)
 
@@ -120,6 +123,8 @@ class OpcUaServer:
         self.requests = 0  # writes and calls answered
         self.accepted = 0  # write batches accepted (handed to the cell)
         self._held: dict[str, int] = {}  # input written -> the batch that wrote it, until a step applied it
+        self._epoch = datetime.now(timezone.utc)  # the wall time of simulated time 0 (`start_clock`)
+        self._t = 0.0  # the simulated time last published
         self._started = False
 
     # -- start and stop ---------------------------------------------------------------------------------
@@ -242,12 +247,19 @@ class OpcUaServer:
         return items
 
     # -- publishing (the cell's side) -----------------------------------------------------------------
-    def publish(self, values: Mapping[str, object], applied: int | None = None) -> None:
+    def start_clock(self, t: float) -> None:
+        """Simulated time `t` is now: SourceTimestamps are this wall time plus simulated seconds since."""
+        self._epoch = datetime.now(timezone.utc) - timedelta(seconds=t)
+
+    def publish(self, values: Mapping[str, object], applied: int | None = None, t: float | None = None) -> None:
         """After a step: put every changed value into the address space and queue it for its monitored items.
 
-        `applied`: how many write batches this server accepted the step had applied (see `CellLink.submit`);
-        an input written since keeps reading as written until a step has applied it."""
-        now = None
+        `applied`: how many write batches this server accepted the step had applied (the adapter's count);
+        an input written since keeps reading as written until a step has applied it. `t`: the step's
+        simulated time (the SourceTimestamp; see the module docstring)."""
+        if t is not None:
+            self._t = t
+        now = source = None
         last, attrs, variables, held = self._last, self._attr, self._var, self._held
         for name, raw in values.items():
             var = variables.get(name)
@@ -262,8 +274,8 @@ class OpcUaServer:
                 continue
             last[name] = value
             if now is None:
-                now = datetime.now(timezone.utc)
-            dv = ua.DataValue(ua.Variant(value, VARIANT[var.data_type]), SourceTimestamp=now, ServerTimestamp=now)
+                now, source = datetime.now(timezone.utc), self._epoch + timedelta(seconds=self._t)
+            dv = ua.DataValue(ua.Variant(value, VARIANT[var.data_type]), SourceTimestamp=source, ServerTimestamp=now)
             self._set(attrs[name], dv)
 
     def send_due(self) -> None:
@@ -301,7 +313,8 @@ class OpcUaServer:
         self._last[var.name] = value
         now = datetime.now(timezone.utc)
         self._set(self._attr[var.name], ua.DataValue(ua.Variant(value, VARIANT[var.data_type]),
-                                                     SourceTimestamp=now, ServerTimestamp=now))
+                                                     SourceTimestamp=self._epoch + timedelta(seconds=self._t),
+                                                     ServerTimestamp=now))
 
     # -- writes (the client's side) -------------------------------------------------------------------
     def _hook_services(self) -> None:
@@ -382,7 +395,7 @@ class OpcUaServer:
             else:
                 accepted.append((i, var, value))
         if accepted:
-            refused = self._submit([(var, value) for _, var, value in accepted])
+            refused = await self._submit([(var, value) for _, var, value in accepted])
             if not refused:
                 self.accepted += 1
             for i, var, value in accepted:
