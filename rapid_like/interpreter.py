@@ -73,7 +73,9 @@ class Interpreter(InstructionsMixin, SystemMixin, SocketsMixin):
         # monitoring, the GripLoad mass (kg), PathAccLim (m/s^2 or None), CornerPathWarning
         self.accset = (100.0, 100.0)
         self.velset = (100.0, 5000.0)
-        self.conf = {"j": False, "l": False}
+        # ConfJ\On and ConfL\On, as a controller starts (the manual's default), unless the host's arm says otherwise
+        on = bool(getattr(host, "conf_monitoring", True))
+        self.conf = {"j": on, "l": on}
         self.gripload = 0.0
         self.path_acc: float | None = None
         self.corner_warning = True

@@ -90,6 +90,8 @@ class TwinHost:
         self.outputs: dict[str, float] = {s.name: 0.0 for s in spec.io if s.drives}
         self.printed: list[str] = []
         self._active: tuple[Record | None, Record | None] = (None, None)  # tooldata, wobjdata of the last motion
+        robot = twin.station.robot
+        self.conf_monitoring = robot.conf_monitoring if robot is not None else True  # at the program's start
 
     # -- signals --------------------------------------------------------------------------------------
     def signals(self) -> Sequence[SignalInfo]:

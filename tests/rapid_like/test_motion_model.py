@@ -340,3 +340,31 @@ def test_movel_with_t_takes_that_time_and_a_heavier_payload_accelerates_less(tmp
     heavy = duration(tmp_path / "heavy", "GripLoad [200,[0,0,100],[1,0,0,0],0,0,0];",
                      "MoveL Offs(p0,0,600,0), v2000, fine, tG;")
     assert heavy > light + 0.05  # the rated payload on top of the gripper: about half the acceleration
+
+
+def test_configuration_monitoring_is_on_at_the_start_as_on_the_controller_unless_the_station_says_otherwise(tmp_path):
+    """The manual: ConfJ\\On and ConfL\\On at a program's start. A station without `conf_monitoring` monitors
+    from the first motion; the shipped rig, whose arm model's axis zeros are not ABB's, starts with it off."""
+    program = f"""MODULE Conf
+  {TOOL}
+  PROC main()
+    MoveJ [[1500,-300,900],[0,1,0,0],[1,0,-1,0],[9E9,9E9,9E9,9E9,9E9,9E9]], v1000, fine, tG;
+  ENDPROC
+ENDMODULE
+"""
+    monitored = station_with(tmp_path / "a", program)
+    toml = monitored / "station.toml"
+    toml.write_text(toml.read_text().replace("conf_monitoring = false", ""))
+    err = io.StringIO()
+    with redirect_stdout(io.StringIO()), redirect_stderr(err):
+        assert rapid(["run", str(monitored / "test.mod"), "--station", str(monitored), "--entry", "main"]) == 70
+    assert ":4:5: error:" in err.getvalue() and "configuration monitoring is on" in err.getvalue()
+    shipped = station_with(tmp_path / "b", program)
+    with redirect_stdout(io.StringIO()):
+        assert rapid(["run", str(shipped / "test.mod"), "--station", str(shipped), "--entry", "main"]) == 0
+    toml = shipped / "station.toml"
+    toml.write_text(toml.read_text().replace("conf_monitoring = false", "conf_monitoring = 0"))
+    err = io.StringIO()
+    with redirect_stdout(io.StringIO()), redirect_stderr(err):
+        assert rapid(["run", str(shipped / "test.mod"), "--station", str(shipped), "--entry", "main"]) != 0
+    assert "conf_monitoring" in err.getvalue()

@@ -106,6 +106,9 @@ class RobotSpec:
     joints: tuple[str, ...] = ARM_JOINTS
     accel_deg: tuple[float, ...] | None = None  # each axis's acceleration limit, deg/s^2 (None: kinematics' default)
     payload_kg: float | None = None  # the rated payload: a load of this mass halves the accelerations
+    # configuration monitoring at the program's start (RAPID's ConfJ\On, ConfL\On, the controller's default); off
+    # for an arm model whose axis zeros differ from the robot the program's confdata were taught on
+    conf_monitoring: bool = True
 
 
 @dataclass(frozen=True)
@@ -390,7 +393,7 @@ def load_station(path: str | Path) -> Station:
         robot = RobotSpec(rr.path_to("urdf"), _placement_key(rr, "base"), tuple(float(v) for v in home),
                           rr.get("flange_link", str, "flange"), tuple(jn),
                           None if accel is None else tuple(float(v) for v in accel),
-                          rr.number("payload_kg", None, positive=True))
+                          rr.number("payload_kg", None, positive=True), rr.get("conf_monitoring", bool, True))
         if len(robot.home_deg) != len(robot.joints):
             raise rr.error("home_deg", f"needs one value per joint ({len(robot.joints)}), has {len(robot.home_deg)}")
         if robot.accel_deg is not None and len(robot.accel_deg) != len(robot.joints):
