@@ -25,7 +25,6 @@ APPLICATION_URI = "urn:gripper-twin:server"
 NONE, SIGN, ENCRYPT = "none", "sign", "encrypt"
 # policy name -> asyncua's SecurityPolicyType member (asyncua is imported only when a server starts)
 POLICIES = {NONE: "NoSecurity", SIGN: "Basic256Sha256_Sign", ENCRYPT: "Basic256Sha256_SignAndEncrypt"}
-READER_ROLE_NAME = "reader:"  # User.name prefix of a read-only account
 
 
 class SecurityError(TwinError):
@@ -131,6 +130,6 @@ class Security:
 
 
 def is_reader(user) -> bool:
-    """A session of a read-only account (its asyncua User's name carries the reader prefix)."""
-    name = getattr(user, "name", None)
-    return isinstance(name, str) and name.startswith(READER_ROLE_NAME)
+    """A session of a read-only account: its asyncua User has the Anonymous role (`_asyncua_roles.Accounts`;
+    asyncua is not imported here, so its role is compared by name)."""
+    return getattr(getattr(user, "role", None), "name", None) == "Anonymous"
