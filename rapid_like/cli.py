@@ -280,6 +280,13 @@ def _main(argv: list[str] | None = None) -> int:
         report(e)
         return EX_DATAERR
     out.flush()
+    moves = getattr(outcome.host, "moves", None) if station is None else None
+    if moves:  # no arm: say once that the motions took no time (docs/rapid.md, "Offline without a station")
+        span = moves[0].span
+        where = f"{span.file}:{span.line}:{span.col}" if span else first
+        print(f"{where}: note: {moves[0].instr} and the motions after it take no time without --station (there is "
+              f"no arm to plan them; in a polling loop a motion takes distance / v_tcp): give --station DIR for "
+              f"the cell's timing", file=err)
     if outcome.reason == "blocked":
         what, span = outcome.waiting
         where = f"{span.file}:{span.line}:{span.col}" if span else first

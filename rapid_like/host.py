@@ -97,6 +97,7 @@ class MotionRequest:
     load_kg: float = 0.0
     conf: bool = False
     path_acc: float | None = None
+    span: object = None  # where the instruction is (FILE:LINE:COL), for notes about it
 
 
 @runtime_checkable

@@ -485,7 +485,7 @@ class InstructionsMixin:
             via_name=text("cirpoint"), speed_name=text("speed"), zone_name=text("zone"),
             tool_name=text("tool"), wobj_name=text("wobj", "wobj0"), line=s.span.line,
             time=seconds, acc=self.accset, stop_point=bool(zone_rec.fields["finep"]) or inpos is not None or at_point,
-            zone_size=zsize, load_kg=load, conf=conf, path_acc=self.path_acc)
+            zone_size=zsize, load_kg=load, conf=conf, path_acc=self.path_acc, span=s.span)
         ev = {"type": "move", "instr": instr, "to": _target_json(target)}
         if via is not None:
             ev["via"] = _target_json(via)

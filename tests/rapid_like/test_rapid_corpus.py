@@ -7,6 +7,7 @@ Each `.mod` file states its own expectations in comments (as craftinginterpreter
     ! trace: {"t": 0.0, "type": "print", "text": "x"}  the trace, line by line, in order (whole trace)
     ! error: 4:10 division by zero                   stderr holds FILE:4:10: error: ...division by zero...
     ! exit: 70                                       the exit status (0 when not given)
+    ! note: 7:5 take no time                         stderr holds FILE:7:5: note: ...take no time...
 
 When a file has `trace:` lines the run uses --trace and the whole trace must match (JSON-equal);
 otherwise stdout is not checked.
@@ -28,7 +29,7 @@ FILES = sorted(CORPUS.rglob("*.mod"))
 
 
 def expectations(path: Path) -> dict:
-    exp: dict = {"args": [], "trace": [], "error": None, "exit": 0, "modules": []}
+    exp: dict = {"args": [], "trace": [], "error": None, "exit": 0, "modules": [], "notes": []}
     for line in path.read_text().splitlines():
         s = line.strip()
         if not s.startswith("!"):
@@ -45,6 +46,9 @@ def expectations(path: Path) -> dict:
         elif key == "error":
             pos, _, msg = rest.partition(" ")
             exp["error"] = (pos, msg.strip())
+        elif key == "note":
+            pos, _, msg = rest.partition(" ")
+            exp["notes"].append((pos, msg.strip()))
         elif key == "exit":
             exp["exit"] = int(rest)
     return exp
@@ -72,6 +76,11 @@ def test_program(path: Path):
     if exp["trace"]:
         got = [json.loads(line) for line in out.splitlines()]
         assert got == exp["trace"], "trace differs:\n" + "\n".join(json.dumps(g) for g in got)
+    notes = [line for line in err.splitlines() if ": note: " in line and not line.startswith(" ")]
+    assert len(notes) == len(exp["notes"]), notes
+    for line, (pos, msg) in zip(notes, exp["notes"]):
+        assert line.startswith(f"{path}:{pos}: note: ") and msg in line, line
+    err = "\n".join(line for line in err.splitlines() if line not in notes)
     if exp["error"]:
         pos, msg = exp["error"]
         first = err.splitlines()[0] if err else ""

@@ -73,3 +73,4 @@ MODULE CondArgs
     TPWrite "timed out " \Bool:=timedOut;
   ENDPROC
 ENDMODULE
+! note: 53:5 take no time without --station

@@ -36,3 +36,4 @@ MODULE Arrays
     MoveL targets{Dim(targets, 1)}, v100, fine, tool0;
   ENDPROC
 ENDMODULE
+! note: 36:5 take no time without --station

@@ -15,3 +15,4 @@ MODULE Calc
     Stop \AllMoveTasks;
   ENDPROC
 ENDMODULE
+! note: 11:5 take no time without --station

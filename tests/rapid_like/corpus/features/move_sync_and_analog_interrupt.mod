@@ -22,3 +22,4 @@ MODULE SyncAndAnalog
     TPWrite "pressure high";
   ENDTRAP
 ENDMODULE
+! note: 15:5 take no time without --station

@@ -17,3 +17,4 @@ MODULE Trigg
     TriggL Offs(p1, 200, 0, 0), v500, gunoff, fine, tool0;
   ENDPROC
 ENDMODULE
+! note: 16:5 take no time without --station

@@ -53,3 +53,4 @@ MODULE CRobTool
     TPWrite "after MoveAbsJ, tLong" \Pos:=c.trans;
   ENDPROC
 ENDMODULE
+! note: 31:5 take no time without --station

@@ -21,3 +21,4 @@ MODULE MoveOptions
     MoveC \Conc, p, p, v100, fine \Inpos:=fllwtime1_0, tool0 \WObj:=fixture \Corr \TLoad:=load0;
   ENDPROC
 ENDMODULE
+! note: 17:5 take no time without --station

@@ -1,5 +1,5 @@
 ! MoveJ, MoveL, MoveC and MoveAbsJ are traced with their target values and the identifiers
-! written; offline they take no time. "wobj" is wobj0 when \WObj is absent.
+! written; offline without --station they take no time (the note says so once). "wobj" is wobj0 when \WObj is absent.
 ! trace: {"t": 0.0, "type": "move", "instr": "MoveJ", "to": {"trans": [1600, -800, 580], "rot": [0, 1, 0, 0]}, "speed": "vmax", "zone": "fine", "tool": "tcpGripper", "wobj": "wobj0"}
 ! trace: {"t": 0.0, "type": "move", "instr": "MoveL", "to": {"trans": [1600, -800, 180], "rot": [0, 1, 0, 0]}, "speed": "v1000", "zone": "z10", "tool": "tcpGripper", "wobj": "wobjPallet"}
 ! trace: {"t": 0.0, "type": "move", "instr": "MoveC", "to": {"trans": [1700, -700, 180], "rot": [0, 1, 0, 0]}, "via": {"trans": [1650, -800, 180], "rot": [0, 1, 0, 0]}, "speed": "v100", "zone": "fine", "tool": "tool0", "wobj": "wobj0"}
@@ -17,3 +17,4 @@ MODULE Moves
     MoveAbsJ jHome, v500, fine, tool0;
   ENDPROC
 ENDMODULE
+! note: 14:5 take no time without --station

@@ -20,3 +20,4 @@ MODULE Frames
     TPWrite "at z=" \Num:=q.trans.z;
   ENDPROC
 ENDMODULE
+! note: 18:5 take no time without --station

@@ -12,3 +12,4 @@ MODULE uses_station
     TPWrite "x in the world " \Num:=here.trans.x;
   ENDPROC
 ENDMODULE
+! note: 10:5 take no time without --station

@@ -31,3 +31,4 @@ MODULE cell_main
     TPWrite "main: " + text;
   ENDPROC
 ENDMODULE
+! note: 21:5 take no time without --station
