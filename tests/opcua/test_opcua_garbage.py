@@ -37,7 +37,13 @@ def test_each_garbage_client_costs_one_log_line_and_no_traceback():
                         pass
                 except (socket.timeout, ConnectionResetError):
                     pass
-        time.sleep(0.5)  # the last lines, through the log's writer thread
+        # the last lines come through the log's writer: wait until none has come for 1 s (a loaded machine may take
+        # longer than any fixed pause), at most 10 s
+        count, quiet_since, deadline = len(server.lines), time.monotonic(), time.monotonic() + 10.0
+        while time.monotonic() - quiet_since < 1.0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+            if len(server.lines) != count:
+                count, quiet_since = len(server.lines), time.monotonic()
         said = server.lines[before:]
 
         async def still_serving():
