@@ -63,12 +63,14 @@ class Poller(threading.Thread):
 
 
 def run(station: Path, seconds: float, *, everything: bool, with_hog: bool, connections: int, items: int,
-        browser) -> dict:
+        browser, rt_priority: bool = True) -> dict:
     from plc_client.testing import twin_server
 
     tmp = tempfile.TemporaryDirectory(prefix="bench-load-")
     extra = ["--opcua", "0", "--opcua-security", "none", "--view", "0",
              "--record", str(Path(tmp.name) / "run.parquet")] if everything else []
+    if not rt_priority:
+        extra.append("--no-rt-priority")
     procs: list[subprocess.Popen] = []
     page = None
     result = {"fps": None, "notifications_s": None, "flood_s": None}
@@ -158,6 +160,8 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--station", type=Path, default=STATION)
     parser.add_argument("--no-browser", action="store_true", help="no Chromium on the page")
     parser.add_argument("--no-hog", action="store_true", help="leave out the two runs beside a CPU hog")
+    parser.add_argument("--no-rt-priority", action="store_true",
+                        help="twin serve --no-rt-priority: without real-time scheduling (to see what it does)")
     args = parser.parse_args(argv)
 
     pw, browser, why = (None, None, "--no-browser") if args.no_browser else open_browser()
@@ -167,7 +171,8 @@ def main(argv: list[str]) -> int:
             for everything in (False, True):
                 label = ("everything" if everything else "quiet") + (" + hog" if hogged else "")
                 runs[label] = run(args.station, args.seconds, everything=everything, with_hog=hogged,
-                                  connections=args.connections, items=args.items, browser=browser)
+                                  connections=args.connections, items=args.items, browser=browser,
+                                  rt_priority=not args.no_rt_priority)
     finally:
         if browser is not None:
             browser.close()
@@ -179,7 +184,8 @@ def main(argv: list[str]) -> int:
 
     print(f"{args.station.name}, real time, {args.seconds:g} s windows; everything = {args.connections} connections "
           f"flooding Modbus, OPC UA {args.items} monitored items, the page open"
-          + (f" (no browser: {why})" if why else " in Chromium") + ", recording on")
+          + (f" (no browser: {why})" if why else " in Chromium") + ", recording on"
+          + ("; twin serve --no-rt-priority" if args.no_rt_priority else ""))
     print(f"{'':30}" + "".join(f"{k:>18}" for k in runs))
     for label, key, spec in (("steps run", "steps", "d"), ("late steps", "late", "d"), ("late steps, %", "late_pct", ".2f"),
                              ("poller p50, ms", "p50", ".2f"), ("poller p99, ms", "p99", ".2f"),

@@ -264,7 +264,8 @@ def cmd_serve(args) -> int:
             cell.add_front_end(front)
         if signals.received is not None:
             raise StopRequested(signals.received)
-        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, stop=stop, priority=True))
+        return asyncio.run(cell.serve(lockstep=args.lockstep, speed=args.speed, stop=stop,
+                                      priority=getattr(args, "rt_priority", True)))
     except BaseException:
         if signals.received is None:
             raise

@@ -95,6 +95,9 @@ def add_serve_arguments(p) -> None:
     mode.add_argument("--lockstep", action="store_true",
                       help="step only when a client writes N to the holding register sim.advance")
     p.add_argument("--speed", type=positive_float, default=1.0, help="real time: X times real time (default 1)")
+    p.add_argument("--no-rt-priority", dest="rt_priority", action="store_false",
+                   help="real time: do not ask the OS for real-time scheduling (default: ask, SCHED_RR at the lowest "
+                        "priority where allowed; see twin.pacing)")
     p.add_argument("--frame-timeout", type=positive_float, default=1.0,
                    help="s a client may take to complete a frame it started (default 1)")
     p.add_argument("--log-level", choices=LEVELS, default="info",
