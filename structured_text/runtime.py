@@ -14,7 +14,8 @@ inputs at the same times give the same run, bit for bit.
 Process images follow OpenPLC's layout: one table per area and size, `%IX100.0` (byte 100, bit 0),
 `%IW100` (word 100), `%QD2`, ... A word address is not a byte offset, so %IW0 and %IX0.0 do not overlap.
 The images are dicts keyed by the address's canonical text (`address_key`: '%IX100.0'), so a fieldbus
-binding may write `plc.inputs` directly; `plc.located()` lists what the program locates.
+binding may write `plc.inputs` directly; `plc.located()` lists what the program locates. Image words are unsigned
+(0..65535); a located signed integer (`AT %IW100 : INT`) takes its word's bits as two's complement.
 
 A run-time error puts the PLC in STOP: `scan` raises PlcFault (FILE:LINE:COL, the task and program
 instance) and every later scan raises it again until `cold_restart()` or `warm_restart()`.
@@ -183,8 +184,8 @@ class Plc:
                 env[names[id(obj)]] = obj
             return names[id(obj)]
         images = {id(self.inputs): "I", id(self.outputs): "Q", id(self.memory): "M"}
-        lines_in = [f"    {name(o)}.{a} = {images[id(img)]}[{key!r}]" for o, a, img, key in self._located_in]
-        lines_out = [f"    {images[id(img)]}[{key!r}] = {name(o)}.{a}" for o, a, img, key in self._located_out]
+        lines_in = [f"    {name(o)}.{a} = {_as_typed(f'{images[id(img)]}[{key!r}]', t)}" for o, a, img, key, t in self._located_in]
+        lines_out = [f"    {images[id(img)]}[{key!r}] = {name(o)}.{a}" for o, a, img, key, _ in self._located_out]
         src = "def _io_in():\n" + "\n".join(lines_in or ["    pass"]) + "\n" + \
               "def _io_out():\n" + "\n".join(lines_out or ["    pass"]) + "\n"
         exec(compile(src, "<located variables>", "exec"), env)
@@ -197,10 +198,10 @@ class Plc:
         key = address_key(area, size, idx)
         image = {"I": self.inputs, "Q": self.outputs, "M": self.memory}[area]
         if area in ("I", "M"):
-            self._located_in.append((obj, s.attr, image, key))
+            self._located_in.append((obj, s.attr, image, key, s.type))
             image.setdefault(key, getattr(obj, s.attr))  # an input never written reads as the initial value
         if area in ("Q", "M"):
-            self._located_out.append((obj, s.attr, image, key))
+            self._located_out.append((obj, s.attr, image, key, s.type))
 
     def _runner(self, inst, obj) -> Callable[[], None]:
         body = obj._body
@@ -466,9 +467,19 @@ class VarRef:
     def _sync_located(self, obj, attr, value) -> None:
         """Setting a located input variable sets its input image too (the next scan reads it from there)."""
         target = obj if obj is not None else self.plc.ns["_G"]
-        for o, a, image, key in self.plc._located_in:
+        for o, a, image, key, _ in self.plc._located_in:
             if o is target and a == attr:
                 image[key] = value
+
+
+def _as_typed(word: str, t) -> str:
+    """The expression a located input variable reads its image word through: a signed integer (SINT, INT,
+    DINT, LINT) takes the word's bits as two's complement, as a PLC's `AT %IW : INT` does (an image holds
+    16-bit words 0..65535: 65535 is -1, not 65535, in an INT); every other type takes the word as it is."""
+    if getattr(t, "kind", None) != "int" or not t.signed:
+        return word
+    half = 1 << (t.bits - 1)
+    return f"((({word}) + {half}) & {2 * half - 1}) - {half}"
 
 
 class LocatedRef:

@@ -203,6 +203,35 @@ END_PROGRAM
                              ("%QW100", "speed", "INT"), ("%MD4", "count", "DINT")]
 
 
+def test_a_signed_located_input_reads_its_word_as_twos_complement(tmp_path):
+    """An input image holds words as a fieldbus hands them over (0..65535); `AT %IW : INT` takes their bits, so a
+    32-bit value split into a signed high word and a low word (a Modbus int32 in two registers) comes back whole."""
+    import struct
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR
+  hi AT %IW100 : INT;
+  lo AT %IW101 : UINT;
+  small AT %IB3 : SINT;
+  word AT %IW102 : WORD;
+END_VAR
+VAR
+  value : DINT;
+END_VAR
+value := INT_TO_DINT(hi) * 65536 + UINT_TO_DINT(lo);
+END_PROGRAM
+""")
+    for v in (-1, -123456, -2**31, 2**31 - 1, 70000):
+        hi, lo = struct.unpack(">HH", struct.pack(">i", v))  # the two registers of a big-endian int32
+        plc.write_located("%IW100", hi)
+        plc.write_located("%IW101", lo)
+        plc.write_located("%IB3", 0xFE)
+        plc.write_located("%IW102", 0xFFFF)
+        plc.scan(0.0)
+        assert (plc.get("main.value"), plc.get("main.lo")) == (v, lo)
+        assert (plc.get("main.small"), plc.get("main.word")) == (-2, 0xFFFF)
+
+
 def test_a_runtime_error_keeps_the_plc_in_stop(tmp_path):
     plc = plc_of(tmp_path, """
 PROGRAM main
