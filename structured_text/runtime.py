@@ -185,7 +185,7 @@ class Plc:
             return names[id(obj)]
         images = {id(self.inputs): "I", id(self.outputs): "Q", id(self.memory): "M"}
         lines_in = [f"    {name(o)}.{a} = {_as_typed(f'{images[id(img)]}[{key!r}]', t)}" for o, a, img, key, t in self._located_in]
-        lines_out = [f"    {images[id(img)]}[{key!r}] = {name(o)}.{a}" for o, a, img, key, _ in self._located_out]
+        lines_out = [f"    {images[id(img)]}[{key!r}] = {_as_word(f'{name(o)}.{a}', t)}" for o, a, img, key, t in self._located_out]
         src = "def _io_in():\n" + "\n".join(lines_in or ["    pass"]) + "\n" + \
               "def _io_out():\n" + "\n".join(lines_out or ["    pass"]) + "\n"
         exec(compile(src, "<located variables>", "exec"), env)
@@ -480,6 +480,15 @@ def _as_typed(word: str, t) -> str:
         return word
     half = 1 << (t.bits - 1)
     return f"((({word}) + {half}) & {2 * half - 1}) - {half}"
+
+
+def _as_word(value: str, t) -> str:
+    """The expression a located output variable writes its image word through: a signed integer's bits as
+    the unsigned word a fieldbus sends (an `AT %QW : INT` holding -1 puts 16#FFFF on the wire), the mirror
+    of `_as_typed`; every other type is written as it is."""
+    if getattr(t, "kind", None) != "int" or not t.signed:
+        return value
+    return f"(({value}) & {(1 << t.bits) - 1})"
 
 
 class LocatedRef:

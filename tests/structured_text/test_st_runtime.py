@@ -232,6 +232,33 @@ END_PROGRAM
         assert (plc.get("main.small"), plc.get("main.word")) == (-2, 0xFFFF)
 
 
+def test_a_signed_located_output_writes_its_bits_as_the_word_a_fieldbus_sends(tmp_path):
+    """The mirror of the input side: `AT %QW : INT` holding -1 puts 16#FFFF in the output image (a Modbus holding
+    register takes 0..65535), and a DINT split into two INT/UINT output words reassembles to the same int32."""
+    import struct
+    plc = plc_of(tmp_path, """
+PROGRAM main
+VAR
+  neg AT %QW100 : INT;
+  hi AT %QW101 : INT;
+  lo AT %QW102 : UINT;
+  small AT %QB7 : SINT;
+END_VAR
+VAR
+  value : DINT := -123456;
+END_VAR
+neg := -1;
+hi := DINT_TO_INT(value / 65536 - BOOL_TO_DINT(value MOD 65536 < 0));
+lo := DINT_TO_UINT(value - INT_TO_DINT(hi) * 65536);
+small := -2;
+END_PROGRAM
+""")
+    plc.scan(0.0)
+    assert plc.read_located("%QW100") == 0xFFFF and plc.read_located("%QB7") == 0xFE
+    words = struct.pack(">HH", plc.read_located("%QW101"), plc.read_located("%QW102"))
+    assert struct.unpack(">i", words)[0] == -123456  # the big-endian int32 of the two registers
+
+
 def test_a_runtime_error_keeps_the_plc_in_stop(tmp_path):
     plc = plc_of(tmp_path, """
 PROGRAM main
