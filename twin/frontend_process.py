@@ -7,6 +7,17 @@ fed the published snapshots and handing its writes back through this adapter; it
 simulation's interpreter, its GIL or its collector, so it can neither make a step late nor change a
 setting of the simulation's process. `twin.pacing` is the only module that knows the wall clock.
 
+    twin serve (SCHED_RR where allowed)          its own processes (spawned, ordinary scheduling)
+    +------------------------------------+      +----------------------------------------------+
+    | one asyncio loop (+ the log's and  | unix | OPC UA: asyncua server, its loop  <- opc.tcp |
+    | events' writer threads):           |<====>|   (twin.opcua.cell_link)                     |
+    |  runner (twin.pacing) -> exchange  | sock +----------------------------------------------+
+    |  Modbus/TCP server      <- tcp     |<====>| page: viser server, its loop   <- http/ws    |
+    |  watchdog, recorder, a FrontEnd-   | unix |   (twin.view.process)                        |
+    |  Process per front end below       | sock |                                              |
+    +------------------------------------+      +----------------------------------------------+
+      snapshots (changed values) ->   <- writes (validated here), Sim.Advance, watchdog feeds, buttons
+
 **The adapter.** `FrontEndProcess(name, "module:factory", options)` is a front end of a cell (the contract in
 `twin_app.cell`). `start` spawns a clean interpreter (no pybullet, no loop copied) that calls
 `factory(options)` and starts the object it returns with a `Remote`: the cell as that process sees it.
@@ -27,7 +38,7 @@ setting of the simulation's process. `twin.pacing` is the only module that knows
   simulation goes on without it.
 
 **Pipes, not shared memory (measured: `python -m bench adapter`).** One snapshot of the ring rig (75 signals,
-one of them text) costs the simulation's process 26 us of CPU through a socket pair (every value pickled,
+one of them text) costs the simulation's process 26 us of CPU through a Unix socket (every value pickled,
 1.3 kB) and 13 us written into a `multiprocessing.shared_memory` block under a sequence lock (doubles only,
 600 B): 0.2 % and 0.1 % of a 12 ms step, the same for the step. Shared memory keeps only the newest snapshot
 (a reader that looks late misses a step, and OPC UA must publish every step), holds no text, makes the
@@ -62,7 +73,7 @@ RUNNER_ACTIONS = ("pause", "resume", "single_step", "request")
 _HEADER = struct.Struct("!I")
 
 
-# -- the wire: length-prefixed pickles over a socket pair, read and written by asyncio on both sides --------
+# -- the wire: length-prefixed pickles over a Unix socket, read and written by asyncio on both sides --------
 def _frame(msg) -> bytes:
     data = pickle.dumps(msg, protocol=pickle.HIGHEST_PROTOCOL)
     return _HEADER.pack(len(data)) + data
