@@ -14,8 +14,6 @@ from twin_app.campaign.cli import with_plc
 
 SHIPPED = STATIONS / "ring_rig_plc" / "campaign.toml"
 VERDICT = ("outcome", "fault", "grips", "misses", "grip", "plc_faults", "part_present")
-pytestmark = pytest.mark.skipif(not (STATIONS.parent / "structured_text" / "runtime.py").exists(),
-                                reason="the ST runtime has not landed")
 
 
 def verdicts(campaign, out, indices) -> dict[str, tuple]:

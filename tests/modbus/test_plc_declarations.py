@@ -145,7 +145,6 @@ def _plc(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "plc_client", *args], cwd=ROOT, capture_output=True, text=True)
 
 
-@pytest.mark.skipif(not (ROOT / "structured_text" / "checker.py").exists(), reason="the ST runtime has not landed")
 def test_the_declarations_pass_plc_check_alone_and_with_a_program_that_uses_them(tmp_path):
     alone = tmp_path / "io.st"
     alone.write_text(twin_map("--format", "st"))

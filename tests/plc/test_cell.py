@@ -104,7 +104,6 @@ def test_the_demo_command_prints_its_steps_and_a_summary(tmp_path):
     check_demo_report(out.stdout, tmp_path / "report")  # the report the demo ends with (tests/view)
 
 
-@pytest.mark.skipif(not (ROOT / "structured_text" / "runtime.py").exists(), reason="the ST runtime has not landed")
 def test_the_gripper_plc_in_structured_text_runs_the_same_cycle(one_cycle):
     """`plc demo` (--plc st, the default): gripper.st over Modbus against `twin serve --layout plc`, its located
     variables bound through the map's device ranges. The same cycle as the Python PLC's, line for line."""

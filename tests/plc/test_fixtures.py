@@ -1,5 +1,4 @@
 """The pytest fixtures of plc_client.testing, used the way docs/commissioning-checks.md shows."""
-import importlib.util
 
 import pytest
 
@@ -7,8 +6,6 @@ from plc_client import ScanCycle, plc_logic
 from tests.plc.conftest import BENCH
 
 pytest_plugins = ["plc_client.testing"]
-pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.front_end") is None,
-                                reason="twin serve is not there yet (twin/modbus/cli.py)")
 
 
 @pytest.fixture
@@ -103,7 +100,6 @@ END_PROGRAM
 """
 
 
-@pytest.mark.skipif(importlib.util.find_spec("structured_text") is None, reason="the ST runtime has not landed")
 def test_an_st_plc_in_lockstep_against_the_station(st_plc, tmp_path):
     """The same check as the Python logic above, written in ST with the station's generated declarations."""
     src = tmp_path / "press.st"

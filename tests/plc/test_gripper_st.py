@@ -15,8 +15,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 CELL = ROOT / "stations" / "ring_rig_plc"
-pytestmark = pytest.mark.skipif(not (ROOT / "structured_text" / "runtime.py").exists(),
-                                reason="the ST runtime has not landed")
 
 DT = 0.012  # the cell's step; both PLCs scan once per step
 AXES, FORCES, CONTACTS, EFFORTS = ("L2", "L3", "L4"), ("L2.force", "L3.force", "L5.force"), \

@@ -1,5 +1,4 @@
 """The client, the `plc` command and the grip sequence against a real `twin serve` on loopback."""
-import importlib.util
 import json
 import os
 import subprocess
@@ -13,8 +12,6 @@ from plc_client.errors import ConnectionFailedError, MapError, UnknownSignalErro
 from plc_client.testing import free_port, twin_server
 from tests.plc.conftest import BENCH, RING_FORCES, STATIONS, ring_sequence
 
-pytestmark = pytest.mark.skipif(importlib.util.find_spec("twin.modbus.front_end") is None,
-                                reason="twin serve is not there yet (twin/modbus/cli.py)")
 EMPTY = BENCH.with_name("ring_bench_empty")  # the ring lies 2.4 m away: every grip misses
 
 

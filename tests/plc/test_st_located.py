@@ -12,8 +12,6 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 CELL = ROOT / "stations" / "ring_rig_plc"
-pytestmark = pytest.mark.skipif(not (ROOT / "structured_text" / "runtime.py").exists(),
-                                reason="the ST runtime has not landed")
 
 BAD = """PROGRAM p
   VAR

@@ -143,8 +143,7 @@ def _marks(path: Path):
 @pytest.mark.parametrize("path", [pytest.param(p, marks=_marks(p), id=str(p.relative_to(CORPUS)))
                                   for p in FILES])
 def test_program(path: Path):
-    if not RUNTIME_PRESENT:
-        pytest.skip("the structured_text package (the ST runtime of issue 19) is not importable yet")
+    assert RUNTIME_PRESENT, "the structured_text package (the ST runtime) is not importable"
     exp = expectations(path)
     if exp["cmd"] == "check":
         argv = ["check", str(path), *exp["files"]]
