@@ -421,3 +421,19 @@ shape = "plane"
     assert all(f["onset_step"] is not None for f in g["fingers"]), text
     for line in (ln for ln in text.splitlines() if " closing: " in ln):
         assert line.startswith("FAIL") and f"close with {closes_with}" in line, line
+
+
+def test_the_newcomers_can_stays_a_steady_2_through_both_drives_reaching_their_force_limit(tmp_path, capsys):
+    """The issue's stall rule, the moment both 40 N drives stall included (a substep apart, they must press alike:
+    statics puts no net force on a centred can): status 2 from 10 steps after touching for as long as the fingers
+    press, the finger's joint (as pybullet reads it) within 0.05 mm, and each presses with its effort within 10 %."""
+    code, text, report = run_check(station("newcomer_2f"), tmp_path, capsys)
+    assert code == 0, text
+    for f in grip(report, "can", "outside")["fingers"]:
+        settled = f["onset_step"] + 10
+        seen = 0
+        for value, count in f["status"]:
+            assert seen + count <= settled or value == 2, (f["finger"], f["status"])
+            seen += count
+        assert f["noise"] <= 0.05e-3, f
+        assert f["force"] == pytest.approx(40.0, rel=0.1), f

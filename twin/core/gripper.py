@@ -437,6 +437,9 @@ class Gripper:
             target = min(max(target, actual - full), actual + full)
             if (target != g and abs(target - actual) >= full * LATCH_FRACTION and (g - actual) * (target - actual) > 0.0
                     and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers)):
+                if way is None:  # stalls now: at exactly that share of its force limit, however far its ramp's last
+                    # substep ran on, so fingers that stall a substep apart press alike (the part does not jump)
+                    target = actual + (1.0 if target > actual else -1.0) * full * LATCH_FRACTION
                 way = 1.0 if target > actual else -1.0  # held short of its goal by a part, at its force limit: stalled
             stalled[name] = way
             command[name] = target
