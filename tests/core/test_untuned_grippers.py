@@ -260,3 +260,4 @@ def test_inertias_that_do_not_fit_a_links_mass_and_size_are_replaced_with_one_wa
             info = twin.world.client.getDynamicsInfo(twin.world.machine, twin.world.link_index[link])
             assert info[2] == pytest.approx(box, rel=1e-6)
         assert not any("base_link" in line for line in lines)  # the fixed root moves nothing: left alone
+

@@ -7,7 +7,7 @@ The drive model (docs/station-format.md, "Drives"). Every input is a servo drive
   v the joint's speed, limited by the effort; within that force pybullet's implicit velocity motor drives the joint
   to the command in one substep (stable for any finger mass); a drive held back at its force limit asks for far more
   speed (the solver builds a motor's force only as fast as the speed it asks for);
-- a drive stalled on a part (95 % of its full-force error, short of its goal, its finger pressing on a target) keeps
+- a drive stalled on a part (97.5 % of its full-force error, exactly, short of its goal, its finger pressing on a target) keeps
   its command where it stands until its force falls by a tenth or the goal changes: the finger holds its place, and
   the rest of its effort resists a push, so two fingers squeezing a part cannot walk it sideways.
 The gains are derived, not tuned (`_derive_drives`): K and D act explicitly, once per substep h, on what the drive
@@ -57,8 +57,8 @@ STIFFNESS_SHARE = 1.0  # ... at most this share of the stiffest spring the step 
 DAMPING_SHARE = 1.0  # the damping: this share of the strongest the step keeps stable, D h / m per drive
 HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
 PUSH_SPEEDUP = 20.0  # how much faster than its velocity limit a held drive asks to move
-LATCH_FRACTION = 0.95  # a drive pressing with this share of its full-force error stalls: its command waits there,
-# and the last 5 % of its effort hold the finger where it stands against a push from the other side
+LATCH_FRACTION = 0.975  # a drive pressing with this share of its full-force error stalls: its command waits there
+# (K e + the holding force: 99.5 % of its effort), and the rest of its effort holds the finger where it stands
 RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
@@ -437,8 +437,8 @@ class Gripper:
             target = min(max(target, actual - full), actual + full)
             if (target != g and abs(target - actual) >= full * LATCH_FRACTION and (g - actual) * (target - actual) > 0.0
                     and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers)):
-                if way is None:  # stalls now: at exactly that share of its force limit, however far its ramp's last
-                    # substep ran on, so fingers that stall a substep apart press alike (the part does not jump)
+                if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on past
+                    # it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
                     target = actual + (1.0 if target > actual else -1.0) * full * LATCH_FRACTION
                 way = 1.0 if target > actual else -1.0  # held short of its goal by a part, at its force limit: stalled
             stalled[name] = way
