@@ -58,7 +58,9 @@ DAMPING_SHARE = 1.0  # the damping: this share of the strongest the step keeps s
 HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
 PUSH_SPEEDUP = 20.0  # how much faster than its velocity limit a held drive asks to move
 LATCH_FRACTION = 0.975  # a drive pressing with this share of its full-force error stalls: its command waits there
-# (K e + the holding force: 99.5 % of its effort), and the rest of its effort holds the finger where it stands
+# (K e + the holding force: 99.5 % of its effort), and the rest of its effort holds the finger where it stands; a part
+# that gives way is followed back to that error (the force stays), one that pushes back meets up to the whole effort
+FOLLOW_FRACTION = 0.965  # ... once the error has fallen below this share (both springs of a squeezed pair hold it)
 RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
@@ -430,6 +432,10 @@ class Gripper:
             way = stalled.get(name)
             if way is not None and (g - before) * way > 0.0 and (before - actual) * way > RELEASE_FRACTION * full:
                 target = before  # stalled on a part: the command waits, so the finger holds where the part stopped it
+                if (target - actual) * way < full * FOLLOW_FRACTION:  # the part gave way: followed, pressing as stalled
+                    target = actual + way * full * LATCH_FRACTION
+                    if (g - target) * way < 0.0:
+                        target = g
             else:
                 way = None
                 target = _towards(before, g, d.velocity * h)
