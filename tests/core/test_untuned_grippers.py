@@ -261,3 +261,43 @@ def test_inertias_that_do_not_fit_a_links_mass_and_size_are_replaced_with_one_wa
             assert info[2] == pytest.approx(box, rel=1e-6)
         assert not any("base_link" in line for line in lines)  # the fixed root moves nothing: left alone
 
+
+def test_mesh_fingers_close_the_way_their_shapes_come_together(tmp_path):
+    """pybullet_data's PR2 gripper: revolute mesh fingers whose link frames sit on their pivots. The twin's closing
+    way (status 2 against 1, `slip`'s let-go) must be the one in which the fingers' collision shapes come together:
+    the closest distance between the two fingers' shapes, asked of a pybullet world of the test's own, shrinks as
+    each input goes to its closing end."""
+    import pybullet
+    import pybullet_data
+
+    urdf = f"{pybullet_data.getDataPath()}/pr2_gripper.urdf"
+    c = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(urdf, physicsClientId=c)
+        joints = {pybullet.getJointInfo(body, j, physicsClientId=c)[1].decode(): j
+                  for j in range(pybullet.getNumJoints(body, physicsClientId=c))}
+        left = (joints["left_gripper_joint"], joints["left_tip_joint"])
+        right = (joints["right_gripper_joint"], joints["right_tip_joint"])
+
+        def gap(name, q):  # one finger at q, the other half open
+            for j, value in ((joints[f"{name}_joint"], q), (joints[f"{'right' if name == 'left_gripper' else 'left'}"
+                                                                     "_gripper_joint"], 0.274)):
+                pybullet.resetJointState(body, j, value, physicsClientId=c)
+            return min(pt[8] for a in left for b in right
+                       for pt in pybullet.getClosestPoints(body, body, 1.0, linkIndexA=a, linkIndexB=b,
+                                                           physicsClientId=c))
+
+        lo, hi = 0.0, 0.548  # the joints' range in the URDF
+        geometry = {name: (-1.0 if gap(name, lo) < gap(name, hi) else 1.0) for name in ("left_gripper", "right_gripper")}
+    finally:
+        pybullet.disconnect(c)
+    (tmp_path / "station.toml").write_text("""[station]
+name = "pr2"
+
+[gripper]
+urdf = "pybullet_data:pr2_gripper.urdf"
+always_active = true
+initial = { left_gripper = 0.5, right_gripper = 0.5 }
+""")
+    with Twin.from_station(tmp_path) as twin:
+        assert twin.gripper.closing == geometry

@@ -341,15 +341,24 @@ class Gripper:
         return chain
 
     def _closing_directions(self) -> dict[str, float]:
-        """Per input, +1 or -1: the way that brings the fingers together (their spread about their common centre
-        shrinks), found by moving each input a little in the loaded world and putting it back."""
+        """Per input, +1 or -1: the way that brings the fingers together (the spread of their collision shapes'
+        centres about their common centre shrinks), found by moving each input a little in the loaded world and
+        putting it back. The shapes, not the link frames: a revolute finger's frame often sits on its pivot (a
+        mesh finger's, as in pybullet_data's pr2_gripper) and moves the other way round than its surface."""
         c, body = self.client, self.body
-        links = [links[0] for links in self.finger_links.values() if links]
-        if not links:
+        fingers = [links for links in self.finger_links.values() if links]
+        if not fingers:
             return {n: -1.0 for n in self.names}
 
+        def shape_centre(links):
+            shaped = [k for k in links if c.getCollisionShapeData(body, k)]
+            if not shaped:  # no collision shape: the link's frame is all there is
+                return c.getLinkState(body, links[0], computeForwardKinematics=True)[0]
+            boxes = [c.getAABB(body, k) for k in shaped]  # a box's centre is a point fixed in its link
+            return [(min(b[0][i] for b in boxes) + max(b[1][i] for b in boxes)) / 2 for i in range(3)]
+
         def points():
-            pts = [c.getLinkState(body, link, computeForwardKinematics=True)[0] for link in links]
+            pts = [shape_centre(links) for links in fingers]
             if len(pts) == 1:  # one finger: its distance from the base (a jaw closing on a fixed one)
                 pts.append(c.getBasePositionAndOrientation(body)[0] if self.base_link < 0
                            else c.getLinkState(body, self.base_link, computeForwardKinematics=True)[0])
