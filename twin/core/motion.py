@@ -140,10 +140,9 @@ class Profile:
             return np.ones_like(ts)
         ta, d = self.ta, self.duration
         with np.errstate(invalid="ignore", over="ignore"):
-            up = self._up_many(np.clip(ts, 0.0, ta))
-            down = self._up_many(np.clip(d - ts, 0.0, ta))
-            out = np.where(ts < ta, up, np.where(ts <= d - ta, self._up_many(np.array([ta]))[0] + self.rate * (ts - ta),
-                                                 1.0 - down))
+            both = self._up_many(np.concatenate([np.clip(ts, 0.0, ta), np.clip(d - ts, 0.0, ta)]))
+            up, down = both[:len(ts)], both[len(ts):]
+            out = np.where(ts < ta, up, np.where(ts <= d - ta, self._up(ta)[0] + self.rate * (ts - ta), 1.0 - down))
         return np.where(ts <= 0, 0.0, np.where(ts >= d, 1.0, out))
 
     def _up_many(self, t: np.ndarray) -> np.ndarray:
