@@ -96,10 +96,7 @@ def test_a_contact_flag_rises_only_where_the_finger_touches_the_part(name):
 
 
 @pytest.mark.parametrize("name", [
-    pytest.param("newcomer_2f", marks=pytest.mark.xfail(strict=True, reason=(
-        "known: closed from 30 mm the first finger's impact tips the can 3.3 mrad onto one rim; the table's anchored "
-        "friction (0.5 N) then loads the squeezed pair, which drifts 0.3 mm/s and takes up 0.04 mm when the drives "
-        "stall (the doctor's closer approach passes)"))),
+    "newcomer_2f",
     "newcomer_2f_box", "newcomer_2f_steel", "light_5n", "sloppy_inertia"])
 def test_two_fingers_squeezing_a_part_stay_still_from_ten_steps_after_touching_through_reaching_full_force(name):
     """The issue's rule for as long as it presses, the moment both drives reach their force limit included: two
