@@ -73,6 +73,23 @@ def slerp_many(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
     return (np.sin((1.0 - s) * theta) / sin_t) * a + (np.sin(s * theta) / sin_t) * b
 
 
+def quat_from_matrix(m: np.ndarray) -> np.ndarray:
+    """The unit quaternion (x, y, z, w) of a 3x3 rotation matrix (inverse of `quat_matrix`, w >= 0)."""
+    t = float(np.trace(m))
+    if t > 0:
+        s = 2.0 * math.sqrt(1.0 + t)
+        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+    else:
+        i = int(np.argmax(np.diag(m)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(max(1.0 + m[i, i] - m[j, j] - m[k, k], 1e-300))
+        q = [0.0, 0.0, 0.0, (m[k, j] - m[j, k]) / s]
+        q[i], q[j], q[k] = 0.25 * s, (m[j, i] + m[i, j]) / s, (m[k, i] + m[i, k]) / s
+        if q[3] < 0:
+            q = [-v for v in q]
+    return quat_normalize(q)
+
+
 def rotation_angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The rotation angles (rad, 0 to pi) between rotation matrices a and b ((N, 3, 3) each, or one of them (3, 3))."""
     rel = np.swapaxes(a, -1, -2) @ b

@@ -26,7 +26,7 @@ from typing import Callable, Iterable, Sequence
 import numpy as np
 
 from .errors import MotionError
-from .geometry import Pose, quat_matrices, rotation_angles, slerp, slerp_many
+from .geometry import Pose, quat_from_matrix, quat_matrices, rotation_angles, slerp, slerp_many
 from .kinematics import DEFAULT_ACCEL_TIME, ArmKinematics, JointLimit, check_limits
 
 #: Cartesian paths are solved at least every SAMPLE_STEP m and SAMPLE_ANGLE rad.
@@ -242,7 +242,10 @@ class Trajectory:
 
     def tcp(self, q: np.ndarray) -> Pose:
         """The TCP for joint positions q of this motion (its tool); a point motion's q is the TCP's position."""
-        return self.kin.fk(q) if self.kin is not None else Pose(q[:3])
+        if self.kin is None:
+            return Pose(q[:3])
+        position, rotation = self.kin.fk_many(np.asarray(q, dtype=float)[None, :])
+        return Pose(position[0], quat_from_matrix(rotation[0]))
 
     def tcp_many(self, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         """`tcp` of many joint positions (N, axes) at once: positions (N, 3), rotation matrices (N, 3, 3) or None

@@ -215,8 +215,14 @@ class MotionQueue:
         narrowed down to ENTRY_RESOLUTION (REFINE times at once)."""
         centre, orientation = point.position, quat_matrix(point.orientation)
 
-        def inside(ts: np.ndarray) -> np.ndarray:
-            positions, rotations = traj.tcp_many(traj.q_many(ts))
+        def inside(ts: np.ndarray, first: bool = False) -> np.ndarray:
+            cached = getattr(traj, "_last_batch", None) if first else None  # (the zone's and the corner's search)
+            if cached is not None and np.array_equal(cached[0], ts):
+                positions, rotations = cached[1], cached[2]
+            else:
+                positions, rotations = traj.tcp_many(traj.q_many(ts))
+                if first:
+                    traj._last_batch = (ts, positions, rotations)
             ok = np.linalg.norm(positions - centre, axis=1) <= radius
             if math.isfinite(angle) and rotations is not None:
                 ok &= rotation_angles(rotations, orientation) <= angle
@@ -227,7 +233,7 @@ class MotionQueue:
         top = d
         while True:
             times = np.maximum(top - step * np.arange(64), 0.0)
-            outside = np.flatnonzero(~inside(times))
+            outside = np.flatnonzero(~inside(times, top == d))
             if len(outside):
                 lo = float(times[outside[0]])
                 break
