@@ -1,4 +1,6 @@
 """The grip sequence (the thesis's gripper PLC) in process, against real twin physics, scan by scan."""
+import math
+
 import pytest
 
 from plc_client.grip_sequence import Fault, GripSequence, Phase
@@ -17,6 +19,27 @@ def test_outside_grip_is_confirmed_when_every_finger_force_passes_the_threshold(
     assert image["L2.actual"] == pytest.approx(320.0, abs=1.5)  # stopped on the ring's 320 mm outside
     bench.plc.run(seconds=1.0)  # held: the setpoints stay, the force stays
     assert bench.twin.read("doGripped") and all(bench.io.get(f) >= 100.0 for f in RING_FORCES)
+
+
+def test_a_held_ring_stands_still_with_every_finger_force_steady_at_its_statics(bench):
+    """Held for 1 s, the squeezed ring is at rest, so each finger presses as its drives' springs say: L2 and L3 are
+    set more than their full-force error (1 mm) past the ring, so they press with their effort (URDF: 1500 N);
+    finger 3 is the fine axis L5 riding on the carriage L4, two springs of 1500 N/mm in series, pressing with
+    1500 N/mm / 2 times how far their setpoints together lie past the ring (up to the effort). No flicker."""
+    bench.request("grip_request")
+    bench.wait(Phase.HELD, Phase.FAULT_MISSED)
+    bench.plc.run(seconds=0.2)  # the press settles
+    t, effort, k = bench.twin, 1500.0, 1500.0 / 1.0  # N, N/mm (the effort at 1 mm of following error)
+    ring = t.object_pose("ring")[0]
+    for _ in range(25):
+        bench.plc.run(seconds=0.04)
+        finger3 = bench.io.get("L4.actual") + bench.io.get("L5.actual")  # its inner face's radius (mm)
+        set3 = (t.read("L4") + t.read("L5")) * 1000.0  # the setpoints (m)
+        expected = {"L2.force": effort, "L3.force": effort, "L5.force": min(effort, k / 2 * (finger3 - set3))}
+        for name, want in expected.items():
+            assert bench.io.get(name) == pytest.approx(want, rel=0.1), name
+        assert t.read("doGripped")
+    assert math.dist(t.object_pose("ring")[0], ring) < 0.0001  # still within 0.1 mm
 
 
 def test_inside_grip_is_confirmed_by_force_in_the_bore(bench_inside):

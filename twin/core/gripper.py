@@ -14,7 +14,9 @@ The drive model (docs/station-format.md, "Drives"). Every input is a servo drive
 The gains are derived, not tuned (`_derive_drives`): K and D act explicitly, once per substep h, on what the drive
 moves, m (its links, its mimic followers', and the lightest target when it carries a finger; about a revolute axis,
 their inertia and the target at the finger's reach), shared by the n fingers' own drives: K <= m / (n h^2) (below
-that the spring is stable), D = m / (n h). A station's stiffness above that limit makes its drive rigid up to its
+that the spring is stable), D = m_own / (n h) (its own links alone: a part resting on a fixture does not move with
+them). Drives in series on a pressed finger (a fine axis on its carriage) take out m_own / m of their error per
+substep: the part holds their sum, and only their own links move between them. A station's stiffness above that limit makes its drive rigid up to its
 effort. A free finger follows its command with almost no force; a finger stopped by a part presses with K times how
 far its setpoint lies past it, up to the effort. What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
@@ -111,6 +113,7 @@ class Drive:
     damping: float = 0.0
     mass: float = 0.0  # kg (kg m^2 for a revolute drive): what it moves, with the lightest target
     limit: float = float("inf")  # the stiffest spring the step keeps stable for that mass (N/m or N m/rad)
+    own: float = 0.0  # kg (kg m^2): its own links' and mimic followers' share of `mass` (without the part)
 
     @property
     def full_error(self) -> float:
@@ -165,6 +168,11 @@ class Gripper:
         self._fingers_of_servo = {name: [f for f, servos in self.finger_servos.items() if name in servos]
                                   for name in self.names}
         self._derive_drives(stiffness_given)
+        # how many springy drives move each drive's fingers in series (a fine axis and the carriage it rides on: 2;
+        # a drive stiffer than the step resolves holds its command rigidly, and is no spring in the chain)
+        springy = {name for name, d in self.drives.items() if d.stiffness <= d.limit}
+        self._series = {name: max((len(springy.intersection(self.finger_servos[f])) for f in fs), default=1)
+                        if name in springy else 1 for name, fs in self._fingers_of_servo.items()}
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
         self.grip_force = {f: spec.grip_force if spec.grip_force is not None
@@ -252,7 +260,7 @@ class Gripper:
                 raise ValueError(f"{name}: the {what} limit must be a finite number >= 0, not {value!r}")
         self.drives[name] = Drive(d.velocity if velocity is None else float(velocity),
                                   d.effort if effort is None else float(effort), d.stiffness, d.damping, d.mass,
-                                  d.limit)
+                                  d.limit, d.own)
 
     def set_active(self, active: bool) -> None:
         """Store the `Active` input; an always-active gripper keeps what was written but ignores it."""
@@ -297,16 +305,19 @@ class Gripper:
             d, links = self.drives[name], moved[name]
             fingers = name in carriers
             if self.unit[name] == "m":
-                mass = sum(mult * mult * c.getDynamicsInfo(body, k)[0] for k, mult in links) + (part if fingers else 0.0)
-                floor = 1e-3
+                own = sum(mult * mult * c.getDynamicsInfo(body, k)[0] for k, mult in links)
+                mass, floor = own + (part if fingers else 0.0), 1e-3
             else:
-                mass, reach = self._inertia_about_axis(name, links, finger_links)
-                mass += part * reach * reach if fingers else 0.0
-                floor = 1e-7
-            mass = max(mass, floor)
+                own, reach = self._inertia_about_axis(name, links, finger_links)
+                mass, floor = own + (part * reach * reach if fingers else 0.0), 1e-7
+            mass, own = max(mass, floor), max(own, floor)
             limit = STIFFNESS_SHARE * mass / (share * h * h)
             stiffness = stiffness_given[name] or min(d.effort / FULL_FORCE_ERROR[self.unit[name]], limit)
-            self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * mass / (share * h), mass, limit)
+            # the damping acts on the drive's own links alone: a part resting on a fixture, or a finger's carriage
+            # swinging against the fine axis it carries, leaves them without the part's mass, and damping derived
+            # with it would overshoot every substep (a limit cycle: a squeezed heavy ring rocked by its fingers)
+            self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * own / (share * h), mass, limit,
+                                      own)
 
     def _inertia_about_axis(self, name: str, links, finger_links: set[int]) -> tuple[float, float]:
         """The inertia (kg m^2) about input `name`'s joint axis of the links it moves, and the reach (m) of its
@@ -468,6 +479,12 @@ class Gripper:
             error = target - actual
             toward = joint_speed if error > 0.0 else -joint_speed
             speed = error / h  # to be at the command after the substep, as far as the force allows
+            if self._series[name] > 1 and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers):
+                # drives in series on one pressed finger (a fine axis on its carriage): the part holds their sum, and
+                # what moves between them is their own links alone, not the part: each taking its whole error out
+                # in one substep throws the pair against each other (every substep, the part standing); each takes
+                # out the share of it that its own links bear to the mass its gains were derived for
+                speed *= d.own / d.mass
             if abs(error) >= full * (1.0 - 1e-9) and toward <= 0.0:
                 # at its force limit and held (or pushed) back: pybullet's solver builds a motor's force only as fast
                 # as the speed it asks for, so a held drive asks for far more than it can have: it presses at its limit
