@@ -11,21 +11,7 @@
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-from twin.core.errors import TwinError  # the project's one error tree
-
-
-@dataclass(frozen=True)
-class Span:
-    """A position in a source file: 1-based line and column."""
-
-    file: str
-    line: int
-    col: int
-
-    def __str__(self) -> str:
-        return f"{self.file}:{self.line}:{self.col}"
+from twin.core.errors import Span, TwinError  # the project's one error tree, and the place in a file
 
 
 class StError(TwinError):

@@ -24,6 +24,21 @@ limit, a scan cycle of 0 s) stay Python's ValueError, as Python's own functions 
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Span:
+    """A position in a user's source file (a RAPID module, a Structured Text program): 1-based line and column.
+    Both interpreters' errors carry one and print it as FILE:LINE:COL."""
+
+    file: str
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.col}"
+
 
 class TwinError(Exception):
     """Base class of the twin core's errors."""
