@@ -446,6 +446,7 @@ class Gripper:
             d = drives[name]
             g = goal[name]
             before = command[name]
+            pressing = any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers)  # last step
             if name in turned:
                 turned.discard(name)
                 if (g - actual) * (before - actual) < 0.0:
@@ -462,14 +463,13 @@ class Gripper:
             else:
                 way = None
                 rate = d.velocity
-                if (before - actual) * (g - actual) > 0.0 and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name]
-                                                                   if f in fingers):
+                if (before - actual) * (g - actual) > 0.0 and pressing:
                     rate = max(rate, full / FORCE_RISE_TIME)  # pressing on a part: full force within 50 ms
                 target = _towards(before, g, rate * h)
             # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
             target = min(max(target, actual - full), actual + full)
             if (target != g and abs(target - actual) >= full * LATCH_FRACTION and (g - actual) * (target - actual) > 0.0
-                    and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers)):
+                    and pressing):
                 if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on past
                     # it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
                     target = actual + (1.0 if target > actual else -1.0) * full * LATCH_FRACTION
@@ -479,7 +479,7 @@ class Gripper:
             error = target - actual
             toward = joint_speed if error > 0.0 else -joint_speed
             speed = error / h  # to be at the command after the substep, as far as the force allows
-            if self._series[name] > 1 and any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers):
+            if self._series[name] > 1 and pressing:
                 # drives in series on one pressed finger (a fine axis on its carriage): the part holds their sum, and
                 # what moves between them is their own links alone, not the part: each taking its whole error out
                 # in one substep throws the pair against each other (every substep, the part standing); each takes
