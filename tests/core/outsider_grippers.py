@@ -181,3 +181,35 @@ def first_touch(g, rec, pen) -> dict:
 
 def displacement(a, b) -> float:
     return float(np.linalg.norm(np.array(a[0]) - np.array(b[0])))
+
+
+def tri_in_a_bore(folder: Path) -> Path:
+    """tri_120_60n standing in the bore of an aluminium ring (60 mm bore flat to flat, 90 mm outside, 30 mm tall,
+    12 faces, one facing each finger): its fingers' outer faces, at a radius of q + 10 mm, meet the bore at
+    q = 20 mm; opening them is an inside grip. Returns the station file written into `folder`."""
+    urdf = (GRIPPERS / "tri_120_60n" / "gripper.urdf").as_posix()
+    path = folder / "station.toml"
+    path.write_text(f"""[station]
+name = "tri_120_60n_bore"
+
+[gripper]
+urdf = "{urdf}"
+mount = {{ xyz = [0.0, 0.0, 0.15], rpy_deg = [0.0, 0.0, 0.0] }}
+always_active = true
+initial = {{ f1 = 0.012, f2 = 0.012, f3 = 0.012 }}
+
+[[targets]]
+name = "ring"
+shape = "ring"
+xyz = [0.0, 0.0, 0.015]
+outer_diameter = 0.09
+inner_diameter = 0.06
+height = 0.03
+density = 2700.0
+
+[[fixtures]]
+name = "floor"
+shape = "plane"
+xyz = [0.0, 0.0, 0.0]
+""")
+    return path

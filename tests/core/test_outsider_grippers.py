@@ -4,14 +4,15 @@ gripper's own geometry and statics (tests/core/outsider_grippers.py), never agai
 left alone stays put; each finger closed past its part touches where the geometry says, reports status 2 within 10
 steps, stands still and presses with what statics gives (a scissor lever of a -1 mimic pair: half the 1 N m); the
 nominal shapes overlap at most 0.5 mm; the held part stays; `slip` stays low; actuals stay in range; two runs are
-bit for bit alike. A lift holds a grip of 13x capacity and drops one of 0.65x with `slip` raised."""
+bit for bit alike. A lift holds a grip of 13x capacity and drops one of 0.65x with `slip` raised; the three
+fingers opened into a ring's bore stall on status 1 and press 60 N each."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from tests.core.outsider_grippers import (ALL, GRIPPERS, HEAVY, TRI, G, displacement, first_touch, penetrations,
-                                          run)
+                                          run, tri_in_a_bore)
 from twin.core import Twin
 
 REST = round(5.0 / 0.012)             # 5 s with the fingers open
@@ -148,3 +149,31 @@ def test_a_lift_keeps_a_grip_of_13x_capacity_within_1_mm_and_drops_one_of_0_65x_
             assert abs(lag) < 1e-3 and not twin.read("slip") and twin.read("doGripped")
         else:
             assert lag > 0.09 and twin.read("slip") and not twin.read("doGripped")
+
+
+def test_three_fingers_opened_into_a_bore_stall_on_status_1_and_press_60_n_each(tmp_path):
+    """Inside grip: each finger's outer face (radius q + 10 mm) meets the bore's face (30 mm) at q = 20 mm."""
+    with Twin.from_station(tri_in_a_bore(tmp_path)) as twin:
+        ring0 = twin.object_pose("ring")
+        for f in TRI.fingers:
+            twin.write(f, 0.06)
+        touched, statuses, q, forces, moving = None, [], [], [], []
+        for k in range(round(6.0 / twin.dt)):
+            twin.step()
+            now = [twin.read(f"{f}.actual") for f in TRI.fingers]
+            if touched is None and min(now) + 0.01 >= 0.03 - 0.05e-3:
+                touched, ring_touched = k, twin.object_pose("ring")
+            statuses.append([twin.read(f"{f}.status") for f in TRI.fingers])
+            q.append(now)
+            forces.append([twin.read(f"{f}.force") for f in TRI.fingers])
+            moving.append(any(twin.read(f"{f}.moving") for f in TRI.fingers))
+        assert touched is not None
+        first = next(k for k in range(touched, len(statuses)) if statuses[k] == [1, 1, 1])
+        assert first - touched <= SETTLE and all(s == [1, 1, 1] for s in statuses[first:])
+        held = np.array(q[touched + SETTLE:])
+        assert not any(moving[touched + SETTLE:]) and np.ptp(held, axis=0).max() <= 0.05e-3
+        assert held.max() + 0.01 - 0.03 <= 0.5e-3                       # overlap with the bore's face
+        assert np.mean(forces[touched + SETTLE:], axis=0) == pytest.approx([60.0] * 3, rel=0.10)
+        assert displacement(ring0, ring_touched) < 0.5e-3
+        assert displacement(ring_touched, twin.object_pose("ring")) < 0.2e-3
+        assert not twin.read("slip") and twin.read("GrippedPart") == "ring"
