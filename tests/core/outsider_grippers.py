@@ -213,3 +213,13 @@ shape = "plane"
 xyz = [0.0, 0.0, 0.0]
 """)
     return path
+
+
+def scissor_at(folder: Path, multiplier: float) -> Path:
+    """scissor_mimic with its mimic lever at another multiplier (its limits hold for -0.5 .. -1); the station
+    file written into `folder`."""
+    src = GRIPPERS / "scissor_mimic"
+    (folder / "gripper.urdf").write_text((src / "gripper.urdf").read_text()
+                                         .replace('multiplier="-1"', f'multiplier="{multiplier}"'))
+    (folder / "station.toml").write_text((src / "station.toml").read_text())
+    return folder / "station.toml"

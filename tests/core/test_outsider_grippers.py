@@ -5,14 +5,14 @@ left alone stays put; each finger closed past its part touches where the geometr
 steps, stands still and presses with what statics gives (a scissor lever of a -1 mimic pair: half the 1 N m); the
 nominal shapes overlap at most 0.5 mm; the held part stays; `slip` stays low; actuals stay in range; two runs are
 bit for bit alike. A lift holds a grip of 13x capacity and drops one of 0.65x with `slip` raised; the three
-fingers opened into a ring's bore stall on status 1 and press 60 N each."""
+fingers opened into a ring's bore stall on status 1 and press 60 N each; a 2:1 scissor presses alike with both levers."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from tests.core.outsider_grippers import (ALL, GRIPPERS, HEAVY, TRI, G, displacement, first_touch, penetrations,
-                                          run, tri_in_a_bore)
+                                          run, scissor_at, tri_in_a_bore)
 from twin.core import Twin
 
 REST = round(5.0 / 0.012)             # 5 s with the fingers open
@@ -177,3 +177,16 @@ def test_three_fingers_opened_into_a_bore_stall_on_status_1_and_press_60_n_each(
         assert displacement(ring0, ring_touched) < 0.5e-3
         assert displacement(ring_touched, twin.object_pose("ring")) < 0.2e-3
         assert not twin.read("slip") and twin.read("GrippedPart") == "ring"
+
+
+def test_a_2_to_1_scissor_presses_a_free_peg_alike_with_both_levers(tmp_path):
+    """lever_a a mimic at -0.5: virtual work gives E = tau_b + 0.5 tau_a; the peg, free on the floor, takes equal
+    forces from both levers, whose contacts lie at the same reach (the levers' tips, 0.1 m): 1 / 1.5 N m each."""
+    with Twin.from_station(scissor_at(tmp_path, -0.5)) as twin:
+        twin.write("lever_b", 0.35)
+        twin.step(40)
+        torques = []
+        for _ in range(40):
+            twin.step()
+            torques.append([twin.read("lever_b.force"), twin.read("lever_a.force")])
+        assert np.mean(torques, axis=0) == pytest.approx([1 / 1.5] * 2, rel=0.10)
