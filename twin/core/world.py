@@ -32,8 +32,10 @@ ROBOT_PREFIX = "robot/"
 COLLISION_MARGIN = 0.0001  # m: pybullet's default 1 mm margin rounds box corners (contact 0.4-0.7 mm late)
 CYLINDER_MARGIN = 0.001  # m: pybullet's own, kept for cylinders (rims round by 0.41 mm; sides are exact)
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
-SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep (20 holds the five test grippers and the ring rig
-# within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50)
+SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
+# rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
+RESIDUAL_SHARE = 2e-3  # ... fewer once converged: the solver stops when no contact's or drive's impulse changes by more
+# than this share of the lightest loose body's weight over a substep in one sweep (`solver_tolerance`)
 
 
 def _mm(xyz) -> str:
@@ -266,6 +268,17 @@ def bind_calls(client: BulletClient) -> None:
         setattr(client, name, functools.partial(getattr(pybullet, name), physicsClientId=client._client))
 
 
+def solver_tolerance(station: Station, substep: float) -> float | None:
+    """N s: the change of impulse per sweep below which the solver has converged: RESIDUAL_SHARE of the lightest
+    loose body's weight over a substep (a resting or held part's statics hold to that share). None: no loose body
+    under gravity to scale by: pybullet's own threshold stays."""
+    g = math.sqrt(sum(v * v for v in station.gravity))
+    masses = [b.mass for b in (*station.fixtures, *station.targets) if b.dynamic]
+    if not masses or g == 0.0:
+        return None
+    return RESIDUAL_SHARE * min(masses) * g * substep
+
+
 class World:
     """A pybullet world built from a station. Owns the connection; `close()` releases it."""
 
@@ -321,6 +334,9 @@ class World:
         # substep keeps both true, and lets the robot and the drives be commanded at every substep
         c.setPhysicsEngineParameter(fixedTimeStep=self.substep, numSubSteps=1, numSolverIterations=SOLVER_ITERATIONS,
                                     deterministicOverlappingPairs=1)
+        tolerance = solver_tolerance(st, self.substep)
+        if tolerance is not None:  # (the solver's measure is the largest squared change of an impulse in a sweep)
+            c.setPhysicsEngineParameter(solverResidualThreshold=tolerance ** 2)
 
     def _create_body(self, body: Body) -> int:
         return create_body(self.client, body)
