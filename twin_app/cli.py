@@ -98,7 +98,7 @@ def _print_drives(target: str) -> None:
     level, quiet.disabled = quiet.disabled, True  # its warnings are listed below, once
     try:
         with Twin.from_station(target) as twin:
-            drives, notes = twin.gripper.drives, twin.world.inertia_notes
+            drives, notes = twin.gripper.drives, twin.world.inertia_notes + twin.gripper.effort_notes
             unit = twin.gripper.unit
     finally:
         quiet.disabled = level

@@ -6,7 +6,9 @@
 - `revolute_chuck`: a 3-jaw chuck of 2 N m revolute levers on a 0.23 kg disc from outside, and into the bore of a
   2.2 kg ring (`revolute_chuck_bore`);
 - `light_5n`: a gantry lift carrying two 5 N fingers of 8 g, a 10 g cube;
-- `sloppy_inertia`: a CAD export with 1 kg m^2 inertias on 50 g fingers, two 50 N fingers, a 0.14 kg cylinder.
+- `sloppy_inertia`: a CAD export with 1 kg m^2 inertias on 50 g fingers, two 50 N fingers, a 0.14 kg cylinder;
+- `pr2_mesh`: pybullet_data's PR2 gripper, two revolute fingers with mesh (STL) proximal links, given 2 N m each in
+  place of the URDF's 1000 N m placeholder, closing their pads on a 20 mm peg.
 
 `GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
 grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
@@ -17,7 +19,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
-         "revolute_chuck_bore", "light_5n", "sloppy_inertia")
+         "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh")
 GRIPPERS = {name: HERE / name for name in NAMES}
 
 
@@ -43,6 +45,7 @@ GRIPS = {  # every finger closed to its range's end: well past the part, so each
     "light_5n": Grip("cube", {"jaw_left": 0.0, "jaw_right": 0.0}, {"jaw_left": 5.0, "jaw_right": 5.0}),
     "sloppy_inertia": Grip("cylinder", {"finger_1_link": 0.0, "finger_2_link": 0.0},
                            {"finger_1_link": 50.0, "finger_2_link": 50.0}),
+    "pr2_mesh": Grip("peg", {"left_gripper": 0.0, "right_gripper": 0.0}, {"left_gripper": 2.0, "right_gripper": 2.0}),
 }
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from .bullet import BulletClient, pybullet
 
+from .meshes import HULL_MARGIN, prepared
 from .native_output import quiet_native_output
 
 PROBE_MARGIN = 0.00001  # m: the copies' margin (a hull's lies outside it and is counted off)
@@ -60,8 +61,8 @@ class ContactProbe:
             kw["meshScales"].append(list(dims) if kind == pybullet.GEOM_MESH else [1, 1, 1])
             kw["collisionFramePositions"].append(list(s[5]))
             kw["collisionFrameOrientations"].append(list(s[6]))
-            if kind == pybullet.GEOM_MESH:
-                correction = PROBE_MARGIN  # a hull's margin lies outside it: its distances read short
+            if kind == pybullet.GEOM_MESH and not prepared(s[4].decode()):
+                correction = HULL_MARGIN  # pybullet's hull of a mesh stands this far outside it: distances read short
         if not types:
             return None
         try:
@@ -69,7 +70,9 @@ class ContactProbe:
         except pybullet.error:
             return None
         copy = c.createMultiBody(0, shape)
-        c.changeDynamics(copy, -1, collisionMargin=PROBE_MARGIN)
+        # a rewritten mesh's pieces need pybullet's own hull margin round them to be the mesh's surface (meshes.py)
+        exact_mesh = any(s[2] == pybullet.GEOM_MESH and prepared(s[4].decode()) for s in shapes)
+        c.changeDynamics(copy, -1, collisionMargin=HULL_MARGIN if exact_mesh else PROBE_MARGIN)
         return copy, correction
 
     def covers(self, link: int) -> bool:

@@ -20,7 +20,7 @@ substep: the part holds their sum, and only their own links move between them. A
 effort. A free finger follows its command with almost no force; a finger stopped by a part presses with K times how
 far its setpoint lies past it, up to the effort. What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
-target objects (averaged over the substeps; a revolute finger's is the torque of those forces about its joint),
+target objects (averaged over the substeps; a revolute finger's is the torque about its joint of those contacts' force, friction included),
 and an axis's speed comes from its positions (pybullet's joint velocity reads the motor's target where a contact
 holds the joint back). Mimic joints are tied to their master by a gear constraint (one motor moves the whole
 linkage). Stepping by hand (fixedTimeStep = step / substeps, one stepSimulation per substep) keeps both motor limits
@@ -43,12 +43,14 @@ The grip rule (`sense`, after each step), the same for outside and inside grips:
 """
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass, field
 
 from .bullet import pybullet
 
 from .mechanism import JointInput, Mechanism
+from .meshes import HULL_MARGIN, prepared
 from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # noqa: F401 (what the signals mean)
 from .signals import FLOAT, INPUT, SignalSpec
 from .station import GripperSpec
@@ -74,6 +76,7 @@ LOST_WATCH_STEPS = 25  # a gripped part no finger presses on any more, and that 
 # slip this many steps more (0.3 s at 12 ms): a dropped part leaves the fingers within a step
 RELEASE_SHARE = 0.25  # a grip lasts while every finger presses with this share of grip_force (no flicker)
 CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
+_warned_efforts: set[str] = set()  # each unreachable effort warned of once per process
 STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
 
 
@@ -168,6 +171,7 @@ class Gripper:
         self._fingers_of_servo = {name: [f for f, servos in self.finger_servos.items() if name in servos]
                                   for name in self.names}
         self._derive_drives(stiffness_given)
+        self.effort_notes = self._unreachable_efforts()
         # how many springy drives move each drive's fingers in series (a fine axis and the carriage it rides on: 2;
         # a drive stiffer than the step resolves holds its command rigidly, and is no spring in the chain)
         springy = {name for name, d in self.drives.items() if d.stiffness <= d.limit}
@@ -205,8 +209,8 @@ class Gripper:
                 client.changeDynamics(body, link, lateralFriction=spec.friction)
                 client.changeDynamics(body, link, collisionMargin=COLLISION_MARGIN)  # (in one call pybullet drops the friction)
                 shapes = client.getCollisionShapeData(body, link)
-                if any(s[2] == pybullet.GEOM_MESH for s in shapes):
-                    self._mesh_links.add(link)  # a hull's margin lies outside it: its distances read short
+                if any(s[2] == pybullet.GEOM_MESH and not prepared(s[4].decode()) for s in shapes):
+                    self._mesh_links.add(link)  # pybullet's hull of a mesh lies 1 mm outside it: distances read short
         # pybullet_utils' client looks every function up anew on each call: the per-substep ones are bound once
         self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
         self._contact_points = client.getContactPoints
@@ -318,6 +322,29 @@ class Gripper:
             # with it would overshoot every substep (a limit cycle: a squeezed heavy ring rocked by its fingers)
             self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * own / (share * h), mass, limit,
                                       own)
+
+    def _unreachable_efforts(self) -> list[str]:
+        """One warning line per drive whose effort it cannot reach anywhere in its joint's range: its full-force
+        error (effort / stiffness, the stiffness capped by what the step keeps stable for what it moves) is longer
+        than the range, so a finger pressing on a part gets at most stiffness x range (an exported placeholder, such
+        as 1000 N m on a 0.1 kg finger). The drive is kept as given; the station should give a real effort."""
+        notes = []
+        for name, d in self.drives.items():
+            lo, hi = self._range[name]
+            if d.stiffness > d.limit or d.full_error <= hi - lo:
+                continue
+            m = self.unit[name] == "m"
+            u, k = ("N", "N/m") if m else ("N m", "N m/rad")
+            note = (f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest position "
+                    f"loop the {self.h * 1000:g} ms substep keeps stable for what it moves ({d.stiffness:.4g} {k}) needs "
+                    f"{d.full_error:.3g} {self.unit[name]} of following error for it, more than the joint's range "
+                    f"({hi - lo:.3g} {self.unit[name]}): a finger presses with at most {d.stiffness * (hi - lo):.3g} {u}. "
+                    f"A placeholder? Give the drive's real effort in [gripper.joints.{name}] effort")
+            notes.append(note)
+            if note not in _warned_efforts:
+                _warned_efforts.add(note)
+                logging.getLogger("twin").warning("warning: %s", note)
+        return notes
 
     def _inertia_about_axis(self, name: str, links, finger_links: set[int]) -> tuple[float, float]:
         """The inertia (kg m^2) about input `name`'s joint axis of the links it moves, and the reach (m) of its
@@ -550,7 +577,7 @@ class Gripper:
                 sums[key] = sums.get(key, 0.0) + force
 
     def _torque(self, finger: str, pt) -> float:
-        """The torque about a revolute finger's joint axis of one contact's normal force on the part."""
+        """The torque about a revolute finger's joint axis of one contact's force (normal and friction) on the part."""
         frame = self._joint_frames.get(finger)
         if frame is None:  # the joint's frame and axis in the world, read once per substep
             link = self.client.getLinkState(self.body, self.finger_joint[finger])
@@ -558,7 +585,9 @@ class Gripper:
             frame = self._joint_frames[finger] = (origin, _rotate(link[5], self._joint_axis[finger]))
         origin, axis = frame
         r = [pt[5][i] - origin[i] for i in range(3)]
-        f = [-pt[7][i] * pt[9] for i in range(3)]  # the normal on B points at A (the finger): the force on B is -n
+        # the contact's whole force on B (the normal on B points at A, the finger: -n N; and its friction), as the
+        # joint carries it in statics (the normal force alone reads 10 % short where friction carries a share)
+        f = [-(pt[7][i] * pt[9] + pt[10] * pt[11][i] + pt[12] * pt[13][i]) for i in range(3)]
         tau = (r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0])
         return sum(tau[i] * axis[i] for i in range(3))
 
@@ -633,14 +662,14 @@ class Gripper:
         for link in self.finger_links[finger]:
             lo, hi = c.getAABB(self.body, link)
             nearby = c.getOverlappingObjects([v - d - COLLISION_MARGIN for v in lo], [v + d + COLLISION_MARGIN for v in hi]) or ()
-            limit = d - (COLLISION_MARGIN if link in self._mesh_links else 0.0)
+            limit = d - (HULL_MARGIN if link in self._mesh_links else 0.0)
             exact = self.probe is not None and self.probe.covers(link)
             for uid in sorted({uid for uid, _ in nearby if uid in self._target_by_id}):
                 if exact:
                     gap = self.probe.distance(link, uid, d)
                     touching = gap is not None and gap <= d
                 else:
-                    touching = any(pt[8] <= limit for pt in c.getClosestPoints(self.body, uid, d + COLLISION_MARGIN,
+                    touching = any(pt[8] <= limit for pt in c.getClosestPoints(self.body, uid, d + HULL_MARGIN,
                                                                                linkIndexA=link))
                 if touching:
                     found.add(self._target_by_id[uid])

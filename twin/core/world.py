@@ -105,18 +105,40 @@ def _read(urdf: Path, file: Path, key: str) -> ET.Element:
         raise StationError(str(file), key, f"{urdf}: cannot be read as a URDF: {exc}") from None
 
 
-def _gripper_for_pybullet(gripper_urdf: Path, file: Path) -> ET.Element:
-    """The gripper's URDF as the world loads it: absolute mesh paths, joints that are not inputs rigid."""
+def _surface_meshes(root: ET.Element, out_dir: Path) -> None:
+    """Every collision mesh (paths already absolute) as the mesh's own surface (twin/core/meshes.py): pybullet's
+    hull of it stands 1 mm proud and fills its hollows. A mesh that cannot be rewritten keeps pybullet's hull."""
+    from .meshes import surface_mesh
+
+    done: dict[tuple, str] = {}
+    for collision in root.iter("collision"):
+        for mesh in collision.iter("mesh"):
+            scale = tuple(float(v) for v in (mesh.get("scale") or "1 1 1").split())
+            key = (mesh.get("filename"), scale)
+            if key not in done:
+                out = surface_mesh(Path(key[0]), scale if len(scale) == 3 else (scale[0],) * 3, out_dir,
+                                   f"mesh{len(done)}")
+                done[key] = str(out) if out is not None else ""
+            if done[key]:
+                mesh.set("filename", done[key])
+                mesh.attrib.pop("scale", None)
+
+
+def _gripper_for_pybullet(gripper_urdf: Path, file: Path, out_dir: Path | None = None) -> ET.Element:
+    """The gripper's URDF as the world loads it: absolute mesh paths, joints that are not inputs rigid, collision
+    meshes as their surface (written into `out_dir`)."""
     gripper = _read(gripper_urdf, file, "gripper.urdf")
     _absolutize_meshes(gripper, gripper_urdf, file, "gripper.urdf")
     _rigid_for_pybullet(gripper)
+    if out_dir is not None:
+        _surface_meshes(gripper, out_dir)
     return gripper
 
 
 def write_gripper(gripper_urdf: Path, file: Path, out_dir: Path) -> Path:
     """The gripper's URDF as the world loads it when there is no robot."""
     out = out_dir / "gripper.urdf"
-    ET.ElementTree(_gripper_for_pybullet(gripper_urdf, file)).write(out)
+    ET.ElementTree(_gripper_for_pybullet(gripper_urdf, file, out_dir)).write(out)
     return out
 
 
@@ -125,7 +147,7 @@ def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper_urdf: P
     """Write one URDF where the gripper's root link hangs off the robot's flange by a fixed joint."""
     robot = _read(robot_urdf, file, "robot.urdf")
     _absolutize_meshes(robot, robot_urdf, file, "robot.urdf")
-    gripper = _gripper_for_pybullet(gripper_urdf, file)
+    gripper = _gripper_for_pybullet(gripper_urdf, file, out_dir)
     for elem in robot:
         if elem.tag in ("link", "joint"):
             elem.set("name", ROBOT_PREFIX + elem.get("name", ""))
