@@ -1,4 +1,4 @@
-"""The front-end adapter's channel (`twin.frontend_process`): what one step's snapshot costs the simulation's
+"""The front-end adapter's channel (`twin.frontends.process`): what one step's snapshot costs the simulation's
 process through a socket pair (as the adapter sends it: length-prefixed pickles) and through shared memory
 under a sequence lock (doubles only), with a reader process on the other side of each.
 
@@ -51,7 +51,7 @@ def snapshot_values(station: Path) -> dict:
 
 
 def measure(values: dict, n: int) -> dict:
-    from twin.frontend_process import _frame
+    from twin.frontends.process import _frame
 
     ctx = mp.get_context("spawn")
     mine, theirs = socket.socketpair()

@@ -33,7 +33,7 @@ def gripper_plc(plc: str):
         return ring_rig.cell_sequence()
     from plc_client.st_io import StLogic
     from stations.ring_rig_plc.demo import DEFAULT_STATION, ST_FILES
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     return StLogic([DEFAULT_STATION / f for f in ST_FILES], build_map(STATION, "plc"))
 

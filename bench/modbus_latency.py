@@ -256,7 +256,7 @@ def main(argv: list[str] | None = None) -> int:
         run_bare_server(args.bare_server[0], args.bare_server[1:])
         return 0
 
-    from twin.modbus.register_map import (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, LATE_STEPS, STEP,
+    from twin.frontends.modbus.register_map import (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, LATE_STEPS, STEP,
                                           build_map)
 
     rmap = build_map(args.station)

@@ -21,7 +21,7 @@ client library on each side. While measuring, the bench swings the finger setpoi
   one signal on each protocol meanwhile (one read every 20 ms). The last line says whether the simulation
   kept real time with the items: a real-time factor of at least 0.99 and at most 1 % of the steps late.
 
-The OPC UA server runs in a process of its own (`twin.opcua.cell_link`): its reads do not wait for steps.
+The OPC UA server runs in a process of its own (`twin.frontends.opcua.cell_link`): its reads do not wait for steps.
 """
 from __future__ import annotations
 
@@ -278,7 +278,7 @@ def row(label: str, ua_ms: list[float], mb_ms: list[float] | None) -> str:
 
 
 async def run(args) -> int:
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     rmap = build_map(args.station)
     station = rmap.station

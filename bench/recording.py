@@ -26,7 +26,7 @@ TARGET = 0.10  # the recorder may cost at most this share of a lockstep step's c
 def lockstep_cost(steps: int, blocks: int = 6, suffix: str = ".parquet") -> dict:
     """Blocks of steps without and with the recorder subscribed, alternately, as `twin serve --lockstep --record`
     runs it (the cell publishes a snapshot per step either way)."""
-    from twin.recording import Recorder
+    from twin.observe.recording import Recorder
     from twin_app.cell import open_cell
 
     bare, recorded = [], []

@@ -32,7 +32,7 @@ def _rig():
 def st_logic():
     from plc_client.st_io import StLogic
     from stations.ring_rig_plc.demo import DEFAULT_STATION, ST_FILES
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     return StLogic([DEFAULT_STATION / f for f in ST_FILES], build_map(DEFAULT_STATION, "plc"))
 

@@ -3,7 +3,7 @@ PLC and the thesis's grip sequence.
 
     from plc_client import TwinClient, ScanCycle, ClientIO, GripSequence
 
-`RegisterMap` and `MapError` are the server's own (`twin.modbus.register_map`), re-exported: one map type
+`RegisterMap` and `MapError` are the server's own (`twin.frontends.modbus.register_map`), re-exported: one map type
 and one map error on both sides of the wire.
 """
 from .client import ClientIO, RegisterMap, Signal, TwinClient
@@ -16,5 +16,3 @@ __all__ = ["TwinClient", "RegisterMap", "Signal", "ClientIO", "ScanCycle", "Comb
            "Handshake", "Phase", "Fault", "PlcClientError", "MapError", "UnknownSignalError", "SignalValueError", "ValueTypeError",
            "ValueOutOfRangeError", "NotWritableError", "ModbusExceptionError", "ConnectionFailedError",
            "OutputRefusedError"]
-
-import twin as _twin  # noqa: E402,F401  installs twin.moved's finder: old import paths of station code that moved

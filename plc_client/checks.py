@@ -1,6 +1,6 @@
 """The client's checks before the wire: names and values against the register map, in engineering units.
 
-The map itself is the one `twin.modbus.register_map.RegisterMap`; a value is checked by the one write
+The map itself is the one `twin.frontends.modbus.register_map.RegisterMap`; a value is checked by the one write
 validation, `SignalSpec.check`, on the entry as a signal in engineering units (its range, or for an entry
 without one its type's: whole numbers for integer types of scale 1, finite float32). What the client adds
 is how it refuses: an unknown name gets suggestions (`UnknownSignalError`), a refusal names the signal and
@@ -18,7 +18,7 @@ from typing import Any
 
 from twin.core.errors import SignalRangeError, SignalTypeError
 from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, SignalSpec
-from twin.modbus.register_map import TYPE_LIMITS, Entry, RegisterMap
+from twin.frontends.modbus.register_map import TYPE_LIMITS, Entry, RegisterMap
 
 from .errors import NotWritableError, UnknownSignalError, ValueOutOfRangeError, ValueTypeError
 

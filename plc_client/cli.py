@@ -31,9 +31,9 @@ import argparse
 import logging
 import sys
 
-from twin.cli_args import positive_float, positive_int
+from twin_app.cli_args import positive_float, positive_int
 from twin.core.errors import TwinError, one_line
-from twin.modbus.protocol import DEFAULT_PORT, TLS_PORT
+from twin.frontends.modbus.protocol import DEFAULT_PORT, TLS_PORT
 
 from .checks import check_names, check_value, lookup, range_text
 from .client import RegisterMap, Signal, TwinClient
@@ -116,7 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def cmd_demo(args) -> int:
     from twin.core.errors import TwinError
-    from twin.plugins import run_station_demo
+    from twin_app.plugins import run_station_demo
 
     try:
         options = args.demo_options
@@ -305,7 +305,7 @@ def _run_logic(args, logic, rmap: RegisterMap) -> int:
     """Run `logic` on a scan cycle against the server (`plc run`), printing its outputs' changes."""
     from .client import ClientIO
     from .scan import ScanCycle
-    from twin.modbus.register_map import SPEED_PCT
+    from twin.frontends.modbus.register_map import SPEED_PCT
 
     with connect(args, rmap) as client:
         io = ClientIO(client, lockstep=args.lockstep)
@@ -475,7 +475,7 @@ from twin.core.errors import UsageError  # noqa: E402  (the project's one: a Twi
 
 
 def main(argv: list[str] | None = None) -> int:
-    from twin.plugins import parse_command_line
+    from twin_app.plugins import parse_command_line
 
     argv = sys.argv[1:] if argv is None else argv
     st = structured_text_command(argv)

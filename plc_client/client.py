@@ -7,7 +7,7 @@
         plc.read("axis1.actual", "axis1.force", "doGripped")   # {'axis1.actual': 329.9, 'axis1.force': 3.1, 'doGripped': False}
         for t, values in plc.poll(["axis1.force"], interval=0.1, count=10): ...
 
-The register map is the server's own type, `twin.modbus.register_map.RegisterMap` (also importable as
+The register map is the server's own type, `twin.frontends.modbus.register_map.RegisterMap` (also importable as
 `plc_client.RegisterMap`), loaded from `twin map STATION --format json` output (`RegisterMap.from_json`)
 or from a station (`RegisterMap.from_station`: the map the server builds, without physics), so both
 sides agree. A batch read groups signals at contiguous addresses of one table into one request. Values
@@ -28,9 +28,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from twin.modbus.protocol import (DEFAULT_PORT, MAX_READ_BITS, MAX_READ_REGISTERS, MAX_RW_WRITE, MAX_WRITE_BITS,
+from twin.frontends.modbus.protocol import (DEFAULT_PORT, MAX_READ_BITS, MAX_READ_REGISTERS, MAX_RW_WRITE, MAX_WRITE_BITS,
                                   MAX_WRITE_REGISTERS, TLS_PORT)
-from twin.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
+from twin.frontends.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
                                       INPUT_REGISTER, LOCKSTEP, MAP_CRC, STEP, TABLES, WATCHDOG_MS, Entry, MapError,
                                       RegisterMap)
 
@@ -38,7 +38,7 @@ from .checks import check_names, check_value, lookup, range_text  # noqa: F401 (
 from .errors import ConnectionFailedError, ModbusExceptionError, PlcClientError
 from .scan import LocalSignals
 
-Signal = Entry  # one entry of the register map, as the server builds it (twin.modbus.register_map)
+Signal = Entry  # one entry of the register map, as the server builds it (twin.frontends.modbus.register_map)
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ class TlsFiles:
         return ctx
 
 
-# -- encode / decode: the server's own (twin.modbus.register_map.Entry), in engineering units ---------------
+# -- encode / decode: the server's own (twin.frontends.modbus.register_map.Entry), in engineering units ---------------
 def encode(s: Signal, value: Any) -> list:
     """Engineering value (checked) -> register words, or [bit] for the bit tables."""
     if s.choices and not isinstance(value, str):
@@ -137,7 +137,7 @@ _SERVED_MAPS: dict[int, RegisterMap] = {}  # CRC-32 -> a map fetched from a serv
 def fetch_map(host: str = "127.0.0.1", port: int = DEFAULT_PORT, unit_id: int = 1, *, timeout: float = 3.0,
               tls: TlsFiles | None = None) -> RegisterMap:
     """The register map a running server serves, read from the server itself (function 20, read file record:
-    `twin.modbus.pdu.MapFile`): first its CRC-32 and length, then the JSON, unless a map of that CRC was
+    `twin.frontends.modbus.pdu.MapFile`): first its CRC-32 and length, then the JSON, unless a map of that CRC was
     fetched before (a server restarted with another map has another CRC, so it is fetched anew). A document
     whose JSON does not have the CRC it came with is a MapError."""
     import struct
@@ -146,7 +146,7 @@ def fetch_map(host: str = "127.0.0.1", port: int = DEFAULT_PORT, unit_id: int = 
     from pymodbus.exceptions import ModbusException
     from pymodbus.pdu.file_message import FileRecord
 
-    from twin.modbus.pdu import MAP_FILE, RECORDS_PER_FILE
+    from twin.frontends.modbus.pdu import MAP_FILE, RECORDS_PER_FILE
 
     if tls is not None:
         client = ModbusTlsClient(host, port=port, sslctx=tls.context(), timeout=timeout, retries=0)
@@ -215,7 +215,7 @@ class TwinClient:
                 tls: TlsFiles | None = None, heartbeat: float | str | None = "auto") -> "TwinClient":
         """Connect to the server at host:port with the map from a JSON file (`map`) or a `station`, else the map
         the server serves (`fetch_map`).
-        `tls`: Modbus/TCP Security with these certificate files (port default 802, else 5020: `twin.modbus.protocol`).
+        `tls`: Modbus/TCP Security with these certificate files (port default 802, else 5020: `twin.frontends.modbus.protocol`).
         `heartbeat`: see `TwinClient` (a request at least that often, so the server's watchdog sees a quiet
         but healthy PLC)."""
         if port is None:
@@ -362,12 +362,12 @@ class TwinClient:
                 values[s.name] = decode(s, list(words[off:off + s.count]))
         return values
 
-    # -- the process-image windows (twin.modbus.pdu.ImageLayout): a scan in one or two requests ----------
+    # -- the process-image windows (twin.frontends.modbus.pdu.ImageLayout): a scan in one or two requests ----------
     @property
     def layout(self):
         """Where each table sits in the server's process-image windows (computed from the map, as the server does)."""
         if getattr(self, "_layout", None) is None:
-            from twin.modbus.pdu import ImageLayout
+            from twin.frontends.modbus.pdu import ImageLayout
 
             self._layout = ImageLayout({t: self.map.size(t) for t in TABLES})
         return self._layout
@@ -379,7 +379,7 @@ class TwinClient:
 
     def read_window(self) -> "WindowImage":
         """The whole input window in one request (function 3)."""
-        from twin.modbus.pdu import IMAGE_IN
+        from twin.frontends.modbus.pdu import IMAGE_IN
 
         n = self.layout.in_size
         r = self._call(3, "read_holding_registers", IMAGE_IN, n, (), count=n)
@@ -390,7 +390,7 @@ class TwinClient:
         window and read the whole input window back, in one function 23. In lockstep with `advance`, the
         server answers once the steps are done, so the image returned is the state after them. `image`
         (the last one read) gives the current values of the words between the ones written."""
-        from twin.modbus.pdu import IMAGE_IN, IMAGE_OUT
+        from twin.frontends.modbus.pdu import IMAGE_IN, IMAGE_OUT
 
         words = self._out_words(values, image, advance)
         if words is None:
@@ -403,7 +403,7 @@ class TwinClient:
 
     def write_window(self, values: Mapping[str, Any], image: "WindowImage") -> None:
         """Write `values` into the output window in one request (function 16)."""
-        from twin.modbus.pdu import IMAGE_OUT
+        from twin.frontends.modbus.pdu import IMAGE_OUT
 
         start, block = self._out_words(values, image, 0)
         self._call(16, "write_registers", IMAGE_OUT + start, len(block), check_names(self.map, values), block)
@@ -525,7 +525,7 @@ class ClientIO(LocalSignals):
     `sim.advance` (carried over, so the average matches); otherwise the scan cycle paces itself against the
     wall clock and the server runs in real time. `local`: signals the PLC holds itself (see `LocalSignals`).
 
-    The process image travels through the server's process-image windows (`twin.modbus.pdu.ImageLayout`)
+    The process image travels through the server's process-image windows (`twin.frontends.modbus.pdu.ImageLayout`)
     when they fit one request each, as a real PLC's I/O exchange does: in lockstep one function 23 per scan
     (the outputs and sim.advance written, the inputs read back once the steps are done), in real time one
     read of the input window and, when an output changed, one write of the output window. `requests` counts

@@ -1,5 +1,5 @@
 """A demo's report (`plc demo`): the run is recorded by the twin server, and the report is drawn from that recording
-(`twin.report`: the signal plot and a picture of the cell at each grip and release, in one folder).
+(`twin.observe.report`: the signal plot and a picture of the cell at each grip and release, in one folder).
 
 Without the [view] extra (matplotlib, pyarrow) the demo still runs: it records to CSV, and says in one
 line why there is no report.
@@ -29,7 +29,7 @@ def report(record: str, report_dir: str, *, threshold: float | None, narration: 
     except ImportError:
         print("report: not written: it needs matplotlib (pip install 'gripper-twin[view]')", flush=True)
         return None
-    from twin.report import write_report
+    from twin.observe.report import write_report
 
     index = write_report(record, report_dir, threshold=threshold, narration=narration,
                          title=title)

@@ -3,7 +3,7 @@
     TwinError (twin.core.errors)       base of everything gripper-twin raises on purpose: catch it for all
     ├── MapError                       the register map cannot be loaded (names the file and the entry), or
     │                                  the server serves another map; defined once, in
-    │                                  twin.modbus.register_map (`twin map`'s and the server's too),
+    │                                  twin.frontends.modbus.register_map (`twin map`'s and the server's too),
     │                                  re-exported here
     └── PlcClientError                 base of everything else the client raises on purpose
         ├── UnknownSignalError         a name the map does not have ("did you mean ...?")
@@ -24,8 +24,8 @@ import difflib
 from collections.abc import Iterable
 
 from twin.core.errors import SignalError, SignalRangeError, SignalTypeError, TwinError
-from twin.modbus.protocol import EXCEPTION_NAMES
-from twin.modbus.register_map import MapError
+from twin.frontends.modbus.protocol import EXCEPTION_NAMES
+from twin.frontends.modbus.register_map import MapError
 
 __all__ = ["TwinError", "MapError", "PlcClientError", "UnknownSignalError", "SignalValueError", "ValueTypeError",
            "ValueOutOfRangeError",

@@ -15,7 +15,7 @@ much later, in the order sent. Lockstep advances are the test's clock, not the l
 
 The PLC can see its link's state as the input `link.ok` (True while the link is up), as a real PLC
 sees its communication status. `on_exchange` is called for every read that gets through: in process, feed
-the cell's comm-loss watchdog with it (`twin.watchdog.feed`), as the server does for every request.
+the cell's comm-loss watchdog with it (`cell.watchdog.feed`), as the server does for every request.
 """
 from __future__ import annotations
 

@@ -1,10 +1,10 @@
 """A Structured Text PLC's located variables and the twin's register map: the same device ranges a Modbus
-master PLC is configured with (`twin.modbus.register_map.master_ranges`, OpenPLC's convention), so what the
+master PLC is configured with (`twin.frontends.modbus.register_map.master_ranges`, OpenPLC's convention), so what the
 ST PLC reads in the twin is what it reads on the real PLC.
 
 - `located_problems(program, rmap)`: `plc check FILE.st... --station DIR` (or `--map FILE.json`, or `--port P`:
   the server's map): every located variable outside what the master moves, or of a type that cannot hold its
-  register's values, is an error at its declaration naming the signal (`twin.modbus.plc_export.located_problem`).
+  register's values, is an error at its declaration naming the signal (`twin.frontends.modbus.plc_export.located_problem`).
 - `LocatedBinding(rmap)`: the input image from signal values (engineering units, by entry name) word by word
   as the master hands them over, and signal values from the output image.
 """
@@ -13,8 +13,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from twin.modbus.plc_export import located_problem, located_variables
-from twin.modbus.register_map import PLC_LAYOUT, RegisterMap
+from twin.frontends.modbus.plc_export import located_problem, located_variables
+from twin.frontends.modbus.register_map import PLC_LAYOUT, RegisterMap
 
 
 def _located_symbols(program):
@@ -61,7 +61,7 @@ def check_against_map(files: list[str], rmap: RegisterMap) -> int:
     except StError as exc:
         print(exc.headline(), file=sys.stderr)
         return 65
-    from twin.modbus.register_map import MapError
+    from twin.frontends.modbus.register_map import MapError
 
     try:
         problems = located_problems(compiled.program, rmap)
@@ -80,7 +80,7 @@ class LocatedBinding:
 
     def __init__(self, rmap: RegisterMap):
         if rmap.layout and rmap.layout != PLC_LAYOUT:
-            from twin.modbus.register_map import MapError
+            from twin.frontends.modbus.register_map import MapError
 
             raise MapError("an ST PLC's located variables bind to the PLC layout (twin serve --layout plc)")
         self.map = rmap

@@ -208,7 +208,7 @@ if pytest is not None:
                 server = stack.enter_context(twin_server(plc_station, lockstep=True, layout="plc"))
                 files = [Path(f) for f in files]
                 if program is not None:
-                    from twin.modbus.plc_export import to_structured_text
+                    from twin.frontends.modbus.plc_export import to_structured_text
 
                     io = tmp_path / f"io_{program}.st"
                     io.write_text(to_structured_text(server.map, program=program), encoding="utf-8")

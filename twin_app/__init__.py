@@ -5,5 +5,5 @@
 - `twin_app.cli`: the `twin` command (`info`, `map`, `serve`, `demo`);
 
 Nothing below imports it: `twin.core` is the bottom, the controller (`rapid_like`) and the front ends
-(`twin.modbus`, ...) sit between.
+(`twin.frontends.modbus`, ...) sit between.
 """

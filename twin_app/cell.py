@@ -1,7 +1,7 @@
 """A running cell, assembled in one place: twin, controller, exchange, front ends, runner.
 
     from twin_app.cell import Cell
-    from twin.modbus.front_end import ModbusFrontEnd
+    from twin.frontends.modbus.front_end import ModbusFrontEnd
 
     with Cell("stations/my_cell")    as cell:          # twin + its RAPID controller as a Device
         cell.add_front_end(ModbusFrontEnd(port=5020))     # Modbus/TCP; OPC UA and the view plug in alike
@@ -14,11 +14,11 @@ What a `Cell` holds:
   client and every front end can rely on it without starting physics.
 - `twin` (`twin.core.Twin`) and `controller`: the station's `[controller]` (a RAPID program, `rapid_like`)
   attached to the twin through the core's `Device` protocol; the core imports no controller.
-- `watchdog` (`twin.watchdog`): the comm-loss watchdog, a device too; front ends `feed` it per request.
+- `watchdog` (`twin.runtime.watchdog`): the comm-loss watchdog, a device too; front ends `feed` it per request.
 - `register_map`: the Modbus map of `signals` in the layout asked for (its CRC is published as `sim.map_crc` to
   every front end).
-- `exchange` (`twin.exchange.Exchange`): the ONE way front ends see and change the cell.
-- one runner (`twin.pacing`): real time (`speed` x the wall clock) or lockstep (steps on `sim.advance`).
+- `exchange` (`twin.runtime.exchange.Exchange`): the ONE way front ends see and change the cell.
+- one runner (`twin.runtime.pacing`): real time (`speed` x the wall clock) or lockstep (steps on `sim.advance`).
 
 The front-end contract (Modbus today; OPC UA and the web view plug in the same way):
 1. A front end is an object with `name`, `async start(cell) -> list[str]` (bind, subscribe; returns
@@ -36,7 +36,7 @@ The front-end contract (Modbus today; OPC UA and the web view plug in the same w
    the next step, together and in arrival order. `exchange.written(name)` reads an input back at once.
 4. Time is the runner's: front ends never step the cell. In lockstep, writing N to `sim.advance` (or
    `cell.exchange.submit([("sim.advance", N)])`) runs N more steps; `sim.advance` reads the steps left.
-5. The concurrency rule (`twin.frontend_process`): the simulation and its Modbus front end run on one asyncio
+5. The concurrency rule (`twin.frontends.process`): the simulation and its Modbus front end run on one asyncio
    event loop in one process, so a callback or a request handler never sees a step half done; every other
    front end (OPC UA, the live page) runs in a process of its own behind `FrontEndProcess`, fed the
    snapshots and handing its writes back through the exchange. Front ends use `cell.station` (names, units) and, for geometry only, `cell.twin` (never to
@@ -65,12 +65,12 @@ from twin.core.errors import StationError, TwinError
 from twin.core.signal_table import SIM_MAP_CRC, SIM_NAMES, WATCHDOG_MS, station_signals
 from twin.core.station import Station, load_station
 from twin.core.twin import Twin
-from twin.events import CONTROLLER, FAULT, READY, STOPPED, Events
-from twin.exchange import Exchange
-from twin.modbus.log import announce as _announce, log as _log
-from twin.modbus.register_map import RegisterMap, build_register_map
-from twin.pacing import LockstepRunner, RealtimeRunner
-from twin.watchdog import Watchdog
+from twin.observe.events import CONTROLLER, FAULT, READY, STOPPED, Events
+from twin.runtime.exchange import Exchange
+from twin.frontends.modbus.log import announce as _announce, log as _log
+from twin.frontends.modbus.register_map import RegisterMap, build_register_map
+from twin.runtime.pacing import LockstepRunner, RealtimeRunner
+from twin.runtime.watchdog import Watchdog
 
 
 class _ControllerState(ObservingDevice):
@@ -99,7 +99,7 @@ class FrontEnd(Protocol):
 
 
 def add_watchdog(twin: Twin) -> Watchdog:
-    """The comm-loss watchdog (`twin.watchdog`) on a twin, before its controller so a DI may read `comm.lost`;
+    """The comm-loss watchdog (`twin.runtime.watchdog`) on a twin, before its controller so a DI may read `comm.lost`;
     the station's open setpoints must name gripper inputs."""
     spec = twin.station.watchdog
     names = {i.name for i in twin.mechanism.inputs}
@@ -123,9 +123,9 @@ class Cell:
         runtime error; see `rapid_like.controller`); `entry` overrides the station's entry routine.
         A program that does not parse or check raises a `rapid_like` error naming file:line:column.
         `publish=False`: in-process steps take no snapshot (see the module docstring).
-        `events`: the machine interface (`twin.events`, `twin serve --events`): the cell, its controller,
+        `events`: the machine interface (`twin.observe.events`, `twin serve --events`): the cell, its controller,
         its watchdog and its front ends write what happens there.
-        `layout`: the register map's (`twin.modbus.register_map.LAYOUTS`; default the signals layout, `twin serve
+        `layout`: the register map's (`twin.frontends.modbus.register_map.LAYOUTS`; default the signals layout, `twin serve
         --layout plc` the PLC's).
         """
         self.publishing = publish
@@ -218,7 +218,7 @@ class Cell:
 
     def pace(self, *, lockstep: bool = False, speed: float = 1.0, priority: bool = False):
         """Make the runner (it does not run yet): lockstep, or `speed` x real time (`priority`: with real-time
-        scheduling where the OS allows it, see `twin.pacing`)."""
+        scheduling where the OS allows it, see `twin.runtime.pacing`)."""
         self.publishing = True  # front ends read every step's snapshot
         self.runner = (LockstepRunner(self.exchange.step) if lockstep
                        else RealtimeRunner(self.exchange.step, self.dt, speed, priority=priority))

@@ -1,14 +1,14 @@
 """The `twin` command: inspect grippers and stations, run the demo, serve a station, run campaigns.
 
     twin info STATION_OR_URDF [--json]
-    twin serve STATION [Modbus flags: twin.modbus.cli] [--realtime | --lockstep] [--speed X]
+    twin serve STATION [Modbus flags: twin_app.cli_modbus] [--realtime | --lockstep] [--speed X]
     twin map STATION [--format json|csv|md|st|openplc] [--layout signals|plc]
     twin demo [STATION] [OPTIONS]  (a station's demo: its station.toml's [plugins] twin_demo)
     twin campaign ... (twin_app.campaign)
-    twin check STATION [-o grip.png] [--json FILE] [--hold S]  (the station doctor: twin.doctor)
+    twin check STATION [-o grip.png] [--json FILE] [--hold S]  (the station doctor: twin.observe.doctor)
 
 `serve` assembles the cell (`twin_app.cell.Cell`) and plugs its front ends in (Modbus/TCP:
-`twin.modbus.front_end`). It logs to stderr through `twin.modbus.log`: a line when it starts loading the
+`twin.frontends.modbus.front_end`). It logs to stderr through `twin.frontends.modbus.log`: a line when it starts loading the
 station, one when listening, one when stopped (a program reads `--events FILE|-` instead: JSON lines with
 the bound ports, clients, the robot's words, stopped; docs/events.md); it stops
 cleanly on Ctrl-C or SIGTERM (exit 0); one that comes while the station is loading stops it once loaded.
@@ -25,10 +25,10 @@ import signal
 import sys
 from pathlib import Path
 
-from twin.cli_args import positive_float
+from twin_app.cli_args import positive_float
 from twin.core.errors import TwinError, one_line
-from twin.modbus.cli import add_commands as add_modbus_commands, tls_from_args
-from twin.modbus.log import announce, log as _log
+from twin_app.cli_modbus import add_commands as add_modbus_commands, tls_from_args
+from twin.frontends.modbus.log import announce, log as _log
 
 
 INFO_TARGETS = "a gripper .urdf, a station folder or a station.toml"
@@ -121,14 +121,14 @@ def _print_drives(target: str) -> None:
 
 
 def cmd_demo(args) -> int:
-    from twin.plugins import run_station_demo
+    from twin_app.plugins import run_station_demo
 
     return run_station_demo("twin_demo", args.demo_options, prog="twin demo", positional=True)
 
 
 def cmd_check(args) -> int:
     """The station doctor: exit 0 when every check passes (warnings allowed), 1 when one fails."""
-    from twin.doctor import check_station, format_report, save_pictures
+    from twin.observe.doctor import check_station, format_report, save_pictures
 
     if args.output and Path(args.output).suffix.lower() != ".png":
         print(f"twin check: error: -o {args.output}: the picture is a .png", file=sys.stderr)
@@ -202,7 +202,7 @@ class _StartUpSignals:
 
 def open_served_cell(station, events=None, layout: str = ""):
     """A station's cell as the servers run it, its robot controller's words in the log (and, with `events`,
-    in the machine interface: `twin.events`); `layout`: the register map's (`twin serve --layout`)."""
+    in the machine interface: `twin.observe.events`); `layout`: the register map's (`twin serve --layout`)."""
     from .cell import Cell
 
     return Cell(Path(station), on_event=controller_log, events=events, layout=layout)
@@ -211,15 +211,15 @@ def open_served_cell(station, events=None, layout: str = ""):
 def cmd_serve(args) -> int:
     import asyncio
 
-    from twin.modbus import log as serve_log
+    from twin.frontends.modbus import log as serve_log
 
     serve_log.setup(args.log_level)
-    from twin.opcua.serve import check_arguments as check_opcua_arguments
+    from twin.frontends.opcua.serve import check_arguments as check_opcua_arguments
 
     if (problem := check_opcua_arguments(args)) is not None:
         print(f"twin serve: error: {problem}", file=sys.stderr)
         return 2
-    from twin.events import Events
+    from twin.observe.events import Events
 
     try:
         events = Events.open(args.events)
@@ -237,11 +237,11 @@ def cmd_serve(args) -> int:
             _log(f"error: --unit-id {args.unit_id} is also the --map-unit-id: give them different unit ids", logging.ERROR)
             return 2
         announce(f"loading station {args.station}")
-        from twin.modbus.front_end import ModbusFrontEnd
+        from twin.frontends.modbus.front_end import ModbusFrontEnd
 
         cell = open_served_cell(args.station, events, getattr(args, "layout", None) or "")
         if getattr(args, "faults", None):
-            from twin.faults import FaultInjector
+            from twin.runtime.faults import FaultInjector
 
             from .campaign.faultfile import load_fault_file
             from .campaign.spec import SpecError
@@ -253,12 +253,12 @@ def cmd_serve(args) -> int:
                 return 2
         if not (getattr(args, "no_modbus", False) and tls is None):
             cell.add_front_end(ModbusFrontEnd.from_args(args, tls=tls))
-        from twin.opcua.serve import OpcUaFrontEnd
+        from twin.frontends.opcua.serve import OpcUaFrontEnd
 
         opcua = OpcUaFrontEnd.from_args(args)
         if opcua is not None:
             cell.add_front_end(opcua)
-        from twin.view.live import front_ends_from_args  # --record, --view
+        from twin.frontends.view.live import front_ends_from_args  # --record, --view
 
         for front in front_ends_from_args(args):
             cell.add_front_end(front)
@@ -310,11 +310,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_campaign(sub)
     serve = add_modbus_commands(sub, cmd_serve)
-    from twin.view.cli import add_commands as add_view_commands  # view, plot, snapshot
-    from twin.view.cli import add_serve_options  # serve --view [PORT], --record FILE
+    from twin_app.cli_view import add_commands as add_view_commands  # view, plot, snapshot
+    from twin_app.cli_view import add_serve_options  # serve --view [PORT], --record FILE
 
     add_serve_options(serve)
-    from twin.opcua.serve import add_arguments as add_opcua_arguments  # --opcua [PORT], --no-modbus, --opcua-*
+    from .cli_opcua import add_arguments as add_opcua_arguments  # --opcua [PORT], --no-modbus, --opcua-*
 
     add_opcua_arguments(serve)
     serve.add_argument("--events", metavar="FILE|-", default=None,
@@ -325,7 +325,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from twin.plugins import parse_command_line
+    from twin_app.plugins import parse_command_line
 
     args = parse_command_line(build_parser(), argv)  # a station's demo keeps its own options
     try:

@@ -484,7 +484,7 @@ def add_arguments(p) -> None:
     """The options of `plc demo` for this station (the command adds --station)."""
     import argparse
 
-    from twin.cli_args import positive_float, positive_int
+    from twin_app.cli_args import positive_float, positive_int
 
     p.description, p.epilog = __doc__.split("\n\n")[2], EXIT_STATUS_HELP
     p.formatter_class = argparse.RawDescriptionHelpFormatter

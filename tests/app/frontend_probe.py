@@ -1,4 +1,4 @@
-"""A front end for tests/app/test_frontend_process.py, run in its own process by `twin.frontend_process`:
+"""A front end for tests/app/test_frontend_process.py, run in its own process by `twin.frontends.process`:
 it writes, advances and refuses as a client would, and records what it saw in a JSON file."""
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Docs that are true because they are tested: every shell and Python example in README.md, docs/*.md and
-twin/modbus/README.md runs here, as a reader would run it (from the project's folder).
+twin/frontends/modbus/README.md runs here, as a reader would run it (from the project's folder).
 
 An example that cannot run here says so visibly, in its first line: a comment starting `# illustrative:`
 and why (it starts a server on a fixed port, needs a cluster or a real PLC, runs the whole suite, takes
@@ -25,7 +25,7 @@ import pytest
 
 from tests.conftest import ROOT
 
-DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "twin" / "modbus" / "README.md"]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "twin" / "frontends" / "modbus" / "README.md"]
 RUN = ("sh", "python")
 ILLUSTRATIVE = "# illustrative:"
 

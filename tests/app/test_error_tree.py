@@ -47,10 +47,10 @@ def test_every_error_the_project_raises_on_purpose_is_a_twin_error():
     assert len(found) > 30  # the scan sees the packages (SpecError, RapidError, StError, PlcClientError, ...)
     stray = sorted(name for name, cls in found.items() if not issubclass(cls, TwinError) and name not in INTERNAL)
     assert not stray, f"not TwinErrors: {stray}"
-    for name in ("twin.faults.FaultError", "twin.plugins.LoadError", "twin.opcua.security.SecurityError",
-                 "twin.opcua.address_space.AddressSpaceError", "twin_app.campaign.scenario.ScenarioError",
-                 "twin_app.campaign.spec.SpecError", "rapid_like.errors.RapidError", "twin.modbus.register_map.MapError",
-                 "plc_client.errors.PlcClientError", "structured_text.errors.StError", "twin.exchange.SimulationFault"):
+    for name in ("twin.runtime.faults.FaultError", "twin_app.plugins.LoadError", "twin.frontends.opcua.security.SecurityError",
+                 "twin.frontends.opcua.address_space.AddressSpaceError", "twin_app.campaign.scenario.ScenarioError",
+                 "twin_app.campaign.spec.SpecError", "rapid_like.errors.RapidError", "twin.frontends.modbus.register_map.MapError",
+                 "plc_client.errors.PlcClientError", "structured_text.errors.StError", "twin.runtime.exchange.SimulationFault"):
         assert issubclass(found[name], TwinError), name
 
 

@@ -11,7 +11,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 from plc_client.events import EventLog
 from tests.conftest import STATIONS
-from twin.events import Events
+from twin.observe.events import Events
 from twin_app.cli import open_served_cell
 
 STEPS = 7

@@ -1,4 +1,4 @@
-"""A front end in a process of its own (`twin.frontend_process`) sees every step and writes as one in the
+"""A front end in a process of its own (`twin.frontends.process`) sees every step and writes as one in the
 simulation's process would: the same refusals (type and message) and, in lockstep, the same results bit for
 bit as the cell stepped in process."""
 from __future__ import annotations
@@ -7,7 +7,7 @@ import asyncio
 import json
 
 from tests.conftest import STATIONS
-from twin.frontend_process import FrontEndProcess
+from twin.frontends.process import FrontEndProcess
 from twin_app.cell import Cell
 
 SCRIPT = [("submit", [("L2", 9.0)]),            # out of range

@@ -1,6 +1,6 @@
 """The general packages hold no station: no shipped station's name, model, target, signal or I/O name appears
 in their Python sources (code, docstrings, comments). Station code lives beside its station and plugs in by
-a name given at run time (`[plugins]` in station.toml, twin.plugins). The identifiers are read from the
+a name given at run time (`[plugins]` in station.toml, twin_app.plugins). The identifiers are read from the
 stations/ folder itself, so a new station is covered without touching this test."""
 from __future__ import annotations
 
@@ -92,4 +92,4 @@ def test_the_scan_finds_a_station_name_where_one_is_written(tmp_path):
 def test_no_general_package_imports_station_code():
     bad = [f"{path.relative_to(ROOT)} imports {target}" for path in general_sources()
            for target in imports_of(path) if target.split(".")[0] == "stations"]
-    assert not bad, "station code is loaded by a name given at run time (twin.plugins), never imported: " + "; ".join(bad)
+    assert not bad, "station code is loaded by a name given at run time (twin_app.plugins), never imported: " + "; ".join(bad)

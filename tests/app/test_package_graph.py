@@ -1,15 +1,41 @@
-"""The package graph runs one way: `twin.core` at the bottom, the controller (`rapid_like`) and the front ends
-above it (the Structured Text runtime `structured_text` beside `rapid_like`), the application (`twin_app`) on top. Built from the source (ast, imports inside functions too)."""
+"""The package graph runs one way, by concept: `twin.core` (the stepped simulation) at the bottom; `twin.runtime`
+(running a cell in time), `twin.devices` (vendors' devices over the twin) and `twin.observe` (seeing it) on
+the core; `twin.frontends` (Modbus, OPC UA, the page, the front-end process) on those; the controller
+(`rapid_like`) and the Structured Text runtime (`structured_text`) on the core alone; the PLC client above
+the front ends; the application (`twin_app`, and every command's launcher) on top. Built from the source (ast,
+imports inside functions too); every edge between two units must be written down in ALLOWED."""
 from __future__ import annotations
 
 import ast
+import tomllib
 from pathlib import Path
 
 from tests.conftest import ROOT
 
 PACKAGES = ("twin", "twin_app", "rapid_like", "structured_text", "plc_client", "stations", "bench")
-# A package's `__main__.py` is a launcher (like a console script): it belongs to the application layer.
+TWIN_UNITS = ("core", "runtime", "devices", "frontends", "observe")  # twin's packages, each a unit of the graph
+# A command's launcher (a package's `__main__.py`, a console script's module) belongs to the application layer.
 LAUNCHER_LAYER = "twin_app"
+LAUNCHERS = {ref.split(":")[0] for ref in
+             tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["scripts"].values()}
+BELOW_THE_APP = {"twin.core", "twin.runtime", "twin.devices", "twin.observe", "twin.frontends", "rapid_like",
+                 "structured_text", "plc_client"}
+# unit -> the units it may import (each one written down: a new edge is a decision, not an accident)
+ALLOWED = {
+    "twin": set(),  # twin/__init__.py: a docstring
+    "twin.core": set(),
+    "twin.runtime": {"twin.core"},
+    "twin.devices": {"twin.core"},
+    "twin.observe": {"twin.core"},
+    "twin.frontends": {"twin.core", "twin.runtime", "twin.devices", "twin.observe"},
+    "rapid_like": {"twin.core"},
+    "structured_text": {"twin.core"},
+    # one register map on both sides of the wire (twin.frontends.modbus.register_map); the demo's report (observe)
+    "plc_client": {"twin.core", "twin.frontends", "twin.observe", "structured_text"},
+    "twin_app": BELOW_THE_APP,
+    "stations": BELOW_THE_APP | {"twin_app"},  # station code, loaded by name at run time (twin_app.plugins)
+    "bench": BELOW_THE_APP | {"twin_app", "stations"},
+}
 
 
 def module_name(path: Path) -> str:
@@ -46,9 +72,13 @@ def project_files():
 
 
 def layer(module: str, path: Path | None = None) -> str:
-    if path is not None and path.name == "__main__.py":
+    """The unit of the graph a module belongs to: one of twin's packages, or a top-level package."""
+    if path is not None and (path.name == "__main__.py" or module in LAUNCHERS):
         return LAUNCHER_LAYER
-    return module.split(".")[0]
+    parts = module.split(".")
+    if parts[0] == "twin" and len(parts) > 1 and parts[1] in TWIN_UNITS:
+        return f"twin.{parts[1]}"
+    return parts[0]
 
 
 def package_edges() -> dict[str, dict[str, list[str]]]:
@@ -87,10 +117,28 @@ def find_cycle(edges: dict[str, dict[str, list[str]]]) -> list[str] | None:
 
 def test_the_import_scanner_sees_local_and_relative_imports():
     edges = package_edges()
-    assert "twin" in edges["rapid_like"]  # rapid_like/station_host.py binds to twin.core
+    assert "twin.core" in edges["rapid_like"]  # rapid_like/station_host.py binds to twin.core
     assert "rapid_like" in edges["twin_app"]  # the cell assembly attaches the controller (an import in a module)
     assert any("station_host" in e for e in edges["twin_app"]["rapid_like"])
+    assert "twin.core" in edges["twin.observe"]  # relative imports inside twin's packages count too
+    assert layer("plc_client.cli", ROOT / "plc_client" / "cli.py") == LAUNCHER_LAYER  # the `plc` command
     assert find_cycle({"a": {"b": []}, "b": {"c": []}, "c": {"a": []}}) == ["a", "b", "c", "a"]
+
+
+def wrong_edges(edges: dict[str, dict[str, list[str]]]) -> list[str]:
+    return [f"{src} -> {dst} ({'; '.join(why[:2])})" for src, targets in sorted(edges.items())
+            for dst, why in sorted(targets.items()) if dst not in ALLOWED.get(src, set())]
+
+
+def test_every_edge_between_units_is_an_allowed_one():
+    bad = wrong_edges(package_edges())
+    assert not bad, "imports against the layout (tests/app/test_package_graph.py ALLOWED):\n" + "\n".join(bad)
+
+
+def test_a_wrong_edge_is_caught():
+    assert wrong_edges({"twin.observe": {"twin.frontends": ["twin/observe/x.py -> twin.frontends.view"]}})
+    assert wrong_edges({"twin.core": {"twin.runtime": ["twin/core/x.py -> twin.runtime.exchange"]}})
+    assert not wrong_edges({"twin.frontends": {"twin.runtime": ["twin/frontends/x.py -> twin.runtime.exchange"]}})
 
 
 def test_no_cycle_between_packages():
@@ -108,10 +156,11 @@ def test_the_core_imports_nothing_above_it():
     assert not bad, "twin.core must import only itself (and third-party packages): " + "; ".join(bad)
 
 
-def test_front_ends_and_the_controller_do_not_import_the_application():
+def test_nothing_below_the_application_imports_it():
+    """twin, the controller, the ST runtime and the PLC client never import twin_app (a command's launcher may)."""
     bad = [f"{path.relative_to(ROOT)} imports {target}"
            for pkg in ("twin", "rapid_like", "structured_text", "plc_client") for path in sorted((ROOT / pkg).rglob("*.py"))
-           if path.name != "__main__.py"
+           if layer(module_name(path), path) != LAUNCHER_LAYER
            for target in imports_of(path) if target.split(".")[0] == "twin_app"]
     assert not bad, "; ".join(bad)
 
@@ -119,7 +168,5 @@ def test_front_ends_and_the_controller_do_not_import_the_application():
 def test_the_structured_text_runtime_sits_beside_the_rapid_interpreter():
     """structured_text may use twin.core only; the PLC client may use it, never the other way round."""
     edges = package_edges()
-    assert set(edges.get("structured_text", {})) <= {"twin"}, edges.get("structured_text")
-    assert not any(p.startswith("twin.") and not p.startswith("twin.core") for e in edges.get("structured_text", {}).values()
-                   for p in [x.split(" -> ")[1] for x in e])
+    assert set(edges.get("structured_text", {})) <= {"twin.core"}, edges.get("structured_text")
     assert "structured_text" in edges["plc_client"]  # `plc check` / `plc run FILE.st`

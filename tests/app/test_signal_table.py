@@ -66,7 +66,7 @@ def test_a_controller_wired_to_a_missing_signal_is_refused_by_the_static_table_w
 
 NO_PYBULLET = """
 import sys, json
-from twin.modbus.register_map import build_map
+from twin.frontends.modbus.register_map import build_map
 from plc_client import RegisterMap
 rmap = build_map(sys.argv[1])
 client_map = RegisterMap.from_station(sys.argv[1])

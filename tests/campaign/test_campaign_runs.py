@@ -80,7 +80,7 @@ def test_a_failing_expectation_names_the_expectation_and_the_measured_value(tmp_
     xmlschema = pytest.importorskip("xmlschema")
     xmlschema.XMLSchema(DATA / "junit.xsd").validate(tmp_path / "junit.xml")
     # each failing scenario re-run with a recording (every signal at every step): the same run, step for step
-    from twin.recording import Recording
+    from twin.observe.recording import Recording
 
     for r in result.records:
         rec = Recording.open(tmp_path / "failures" / f"{r['index']:04d}.csv")

@@ -7,7 +7,7 @@ from plc_client.link import LINK_OK, LinkFaults
 from plc_client.scan import ScanCycle, TwinIO, plc_logic
 from tests.conftest import ROOT, STATIONS
 from twin.core import Twin
-from twin.faults import (DriveForceLost, FaultError, FaultInjector, FingerJammed, PartDisplaced, PartMissing,
+from twin.runtime.faults import (DriveForceLost, FaultError, FaultInjector, FingerJammed, PartDisplaced, PartMissing,
                          ReadingOffset, ReadingStuck, RobotStopped)
 
 BENCH = ROOT / "tests" / "plc" / "stations" / "ring_bench"  # fingers at 330 mm around a ring of radius 320 mm

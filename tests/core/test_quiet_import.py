@@ -7,7 +7,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_importing_the_twin_and_the_cell_prints_nothing_on_either_stream():
-    out = subprocess.run([sys.executable, "-c", "import twin_app.cell, twin.core.world, twin.picture"],
+    out = subprocess.run([sys.executable, "-c", "import twin_app.cell, twin.core.world, twin.observe.picture"],
                          cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert (out.stdout, out.stderr) == ("", "")

@@ -5,11 +5,11 @@ from __future__ import annotations
 import asyncio
 import struct
 
-from twin.exchange import Exchange
-from twin.modbus.bridge import TwinBridge
-from twin.modbus.register_map import build_register_map
-from twin.modbus.server import ModbusServer
-from twin.pacing import LockstepRunner
+from twin.runtime.exchange import Exchange
+from twin.frontends.modbus.bridge import TwinBridge
+from twin.frontends.modbus.register_map import build_register_map
+from twin.frontends.modbus.server import ModbusServer
+from twin.runtime.pacing import LockstepRunner
 
 from test_pacing_and_bridge import StandIn
 

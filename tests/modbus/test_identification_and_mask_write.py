@@ -56,8 +56,8 @@ def test_a_stream_from_an_unknown_object_restarts_at_object_0_and_bad_requests_g
 
 
 def test_a_response_too_long_for_one_pdu_says_more_follows_and_where_to_go_on():
-    from twin.modbus.pdu import DeviceIdentity, Images, PduHandler
-    from twin.modbus.register_map import build_register_map
+    from twin.frontends.modbus.pdu import DeviceIdentity, Images, PduHandler
+    from twin.frontends.modbus.register_map import build_register_map
 
     ident = DeviceIdentity(extended={0x80 + i: chr(65 + i) * 100 for i in range(5)})
     handler = PduHandler(build_register_map([]), type("B", (), {"images": Images(b"", b"", b"", b"")})(), identity=ident)

@@ -1,4 +1,4 @@
-"""The runners (twin.pacing) and the bridge, in process, against a tiny stand-in twin (no physics)."""
+"""The runners (twin.runtime.pacing) and the bridge, in process, against a tiny stand-in twin (no physics)."""
 from __future__ import annotations
 
 import asyncio
@@ -7,11 +7,11 @@ import time
 
 from twin.core.errors import SignalRangeError
 from twin.core.signals import BOOL, FLOAT, INPUT, OUTPUT, SignalSpec
-from twin.exchange import Exchange
-from twin.modbus.bridge import TwinBridge
-from twin.modbus.register_map import build_register_map
-from twin.modbus.server import ModbusServer
-from twin.pacing import LockstepRunner, RealtimeRunner
+from twin.runtime.exchange import Exchange
+from twin.frontends.modbus.bridge import TwinBridge
+from twin.frontends.modbus.register_map import build_register_map
+from twin.frontends.modbus.server import ModbusServer
+from twin.runtime.pacing import LockstepRunner, RealtimeRunner
 
 
 class StandIn:

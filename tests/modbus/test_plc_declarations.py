@@ -12,8 +12,8 @@ import sys
 import pytest
 
 from modbus_helpers import ROOT
-from twin.modbus.plc_export import RESERVED, st_name
-from twin.modbus.register_map import COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, build_map
+from twin.frontends.modbus.plc_export import RESERVED, st_name
+from twin.frontends.modbus.register_map import COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, build_map
 
 CELL = ROOT / "stations" / "ring_rig_plc"
 IDENT = re.compile(r"^[A-Za-z](?:_?[A-Za-z0-9])*$")  # IEC 61131-3: no leading digit, no double or trailing _
@@ -119,7 +119,7 @@ def test_the_st_formats_refuse_the_signals_layout():
 
 
 def test_a_located_variable_the_master_does_not_serve_or_whose_type_cannot_hold_its_register_is_named():
-    from twin.modbus.plc_export import located_problem
+    from twin.frontends.modbus.plc_export import located_problem
 
     rmap, cfg = build_map(CELL, "plc"), ranges()
     last_di = cfg["Discrete_Inputs_Size"] - 1

@@ -15,7 +15,7 @@ from pymodbus.client import ModbusTcpClient
 
 from modbus_helpers import ROOT, ServerProcess
 from twin.core.signals import OWNERS, PLC
-from twin.modbus.register_map import (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, TABLES, RegisterMap,
+from twin.frontends.modbus.register_map import (COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER, TABLES, RegisterMap,
                                       build_map)
 
 CELL = ROOT / "stations" / "ring_rig_plc"

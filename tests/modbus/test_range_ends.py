@@ -40,7 +40,7 @@ def test_the_exact_ends_of_a_revolute_range_are_accepted_over_modbus_and_through
         assert (lo, hi) == (-5157, 5157)  # the counts nearest the ends (51.57 deg) mean the ends
         from twin.core import Twin
         with Twin.from_station(station) as twin:  # and what the twin gets from the end's count is the exact end
-            from twin.modbus.register_map import build_register_map
+            from twin.frontends.modbus.register_map import build_register_map
             served = {e.name: e for e in build_register_map(twin.signals).entries}["flap"]
             twin.write("flap", served.si_of_words(served.encode(END)))
             assert twin.read("flap") == END

@@ -9,7 +9,7 @@ import math
 import pytest
 
 from twin.core.signals import BOOL, ENUM, FLOAT, INPUT, INT, OUTPUT, SignalSpec
-from twin.modbus.register_map import (ADVANCE, COIL, DISCRETE_INPUT, FAULT, HOLDING_REGISTER, INPUT_REGISTER,
+from twin.frontends.modbus.register_map import (ADVANCE, COIL, DISCRETE_INPUT, FAULT, HOLDING_REGISTER, INPUT_REGISTER,
                                       RESERVED, STEP, TIME_MS, MapError, build_register_map)
 
 SIGNALS = (
@@ -134,7 +134,7 @@ def test_a_name_declared_twice_is_refused():
 
 # -- sim.map_crc: the map's own CRC, so a client can tell it holds the map the server serves -----------------
 def test_the_map_crc_sits_in_the_reserved_block_of_the_input_registers(rmap):
-    from twin.modbus.register_map import MAP_CRC
+    from twin.frontends.modbus.register_map import MAP_CRC
 
     e = rmap[MAP_CRC]
     assert (e.table, e.address, e.count, e.type, e.access) == (INPUT_REGISTER, 10, 2, "uint32", "r")
@@ -145,7 +145,7 @@ def test_the_map_crc_covers_name_table_address_count_type_and_scale_of_every_oth
     import dataclasses
     import zlib
 
-    from twin.modbus.register_map import MAP_CRC, RegisterMap, map_crc
+    from twin.frontends.modbus.register_map import MAP_CRC, RegisterMap, map_crc
 
     order = [COIL, DISCRETE_INPUT, HOLDING_REGISTER, INPUT_REGISTER]
     rows = sorted((e for e in rmap if e.name != MAP_CRC), key=lambda e: (order.index(e.table), e.address))

@@ -241,7 +241,7 @@ def test_a_wrong_station_or_a_busy_port_is_one_line_on_stderr_and_exit_2(lockste
 def test_the_smart_gripper_grips_its_cube_in_real_time_by_one_register_write():
     from modbus_helpers import SMART_GRIPPER
 
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     rmap = build_map(SMART_GRIPPER)
     with ServerProcess(SMART_GRIPPER) as server, connect(server) as c:
@@ -257,7 +257,7 @@ def test_the_smart_gripper_grips_its_cube_in_real_time_by_one_register_write():
 
 
 def test_the_ring_rig_serves_its_robot_axes_in_hundredths_of_a_degree():
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     ring_rig = ROOT / "stations" / "ring_rig"
     rmap = build_map(ring_rig)
@@ -311,7 +311,7 @@ def test_a_second_signal_while_loading_cuts_the_loading_short():
 
 
 def test_the_ring_rig_grips_its_ring_by_register_writes_alone():
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     ring_rig = ROOT / "stations" / "ring_rig"
     rmap = build_map(ring_rig)  # the cell starts with the open gripper around the ring on the right pallet

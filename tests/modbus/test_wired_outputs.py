@@ -8,7 +8,7 @@ import pytest
 
 from tests.conftest import STATIONS
 from twin_app.cell import open_cell
-from twin.modbus.bridge import TwinBridge
+from twin.frontends.modbus.bridge import TwinBridge
 
 
 def test_ao_axis1_mirrors_l2_whoever_wrote_it():

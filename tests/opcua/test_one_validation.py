@@ -21,11 +21,11 @@ from tests.conftest import ROOT
 from twin.core.errors import SignalError, SignalRangeError, SignalTypeError, TwinError
 from twin.core.signal_table import station_signals
 from twin.core.station import load_station
-from twin.view.live import check_write
+from twin.frontends.view.live import check_write
 
 BENCH = ROOT / "tests" / "plc" / "stations" / "ring_bench"
 # Modbus/TCP: a value refused by the validation is exception 03 (ILLEGAL DATA VALUE; an output is in a read-only
-# table, so no write names it); OPC UA: see twin.opcua.errors.status_of and docs/opcua.md
+# table, so no write names it); OPC UA: see twin.frontends.opcua.errors.status_of and docs/opcua.md
 MODBUS = {SignalRangeError: 0x03, SignalTypeError: 0x03}
 # (signal, value in SI, the OPC UA Variant type the client sends, what the page and the client are given)
 BAD = [("L2", 0.5, ua.VariantType.Double), ("L2", -0.001, ua.VariantType.Double),
@@ -61,7 +61,7 @@ def test_the_same_bad_writes_are_refused_for_the_same_reason_everywhere(tmp_path
     assert {type(e) for e in expected.values()} == {SignalRangeError, SignalTypeError, SignalError}
 
     # the page: the scene's signals as the page process gets them, its message the validation's own
-    from twin.observe import _signal_dict
+    from twin.observe.scene import _signal_dict
 
     for (name, value), err in expected.items():
         value = math.nan if value == "nan" else value

@@ -7,7 +7,7 @@ from datetime import datetime, timezone
 from asyncua import ua
 from asyncua.ua import ua_binary
 
-from twin.opcua.server import encode_each_value_once
+from twin.frontends.opcua.server import encode_each_value_once
 
 
 def test_notifications_encode_to_the_same_bytes_as_asyncuas_own_encoder():

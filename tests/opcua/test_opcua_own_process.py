@@ -1,4 +1,4 @@
-"""The OPC UA server runs in a process of its own (`twin.frontend_process`): a client's reads are answered while
+"""The OPC UA server runs in a process of its own (`twin.frontends.process`): a client's reads are answered while
 the cell's loop is busy (as in a long simulation step), and what it reads is the cell's last published step; a
 write is answered once the simulation's process has validated it, and reads back as written. No timing: the
 cell's loop is held until the client has its read answers, so a server that needed that loop would never answer.
@@ -17,8 +17,8 @@ def test_reads_are_answered_while_the_cells_loop_is_busy_and_the_simulations_pro
     import gc
     import sys
 
-    from twin.opcua.security import Security
-    from twin.opcua.serve import OpcUaFrontEnd
+    from twin.frontends.opcua.security import Security
+    from twin.frontends.opcua.serve import OpcUaFrontEnd
     from twin_app.cell import Cell
 
     answers: dict[str, object] = {}

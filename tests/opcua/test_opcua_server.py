@@ -20,7 +20,7 @@ UNIT = 1
 
 @pytest.fixture(scope="module")
 def rmap():
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     return build_map(RING_RIG)
 

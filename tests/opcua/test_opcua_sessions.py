@@ -94,7 +94,7 @@ def test_opcua_sessions_feed_the_watchdog_and_a_silent_one_lets_comm_lost_rise()
 
 def directions() -> tuple[list[str], list[str]]:
     """The cell's inputs and outputs by the Modbus map (an input is a coil or a holding register)."""
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     rmap = build_map(RING_RIG)
     inputs = [e.name for e in rmap if e.table in ("coil", "holding_register")]

@@ -9,7 +9,7 @@ from plc_client.grip_sequence import Fault, Phase
 from plc_client.link import LinkFaults
 from plc_client.scan import ScanCycle
 from tests.plc.conftest import BENCH, RING_FORCES, Bench, ring_sequence
-from twin.faults import DriveForceLost, FaultInjector, FingerJammed, ReadingStuck
+from twin.runtime.faults import DriveForceLost, FaultInjector, FingerJammed, ReadingStuck
 
 
 def test_a_slow_drive_is_waited_for_not_taken_for_a_fault(bench):

@@ -110,7 +110,7 @@ def run_python(plant: Plant, robot: Robot, steps: int) -> list[tuple]:
 def run_st(plant: Plant, robot: Robot, steps: int, io: Path) -> list[tuple]:
     from plc_client.st_io import LocatedBinding
     from structured_text.runtime import load
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     plc = load([CELL / "gripper.st", io])
     binding = LocatedBinding(build_map(CELL, "plc"))  # the input image word by word as the master hands it over

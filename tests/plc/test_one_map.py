@@ -1,5 +1,5 @@
 """One register map type and one map error on both sides of the wire: the PLC client loads the server's own
-`twin.modbus.register_map.RegisterMap`, from a station or from `twin map --format json` output, and a map it
+`twin.frontends.modbus.register_map.RegisterMap`, from a station or from `twin map --format json` output, and a map it
 cannot load is one `MapError` naming the file and the entry."""
 import json
 import subprocess
@@ -13,8 +13,8 @@ from plc_client.checks import check_value
 from plc_client.client import decode, encode, plan_reads
 from plc_client.errors import PlcClientError, UnknownSignalError
 from twin.core.errors import TwinError
-from twin.modbus import register_map
-from twin.modbus.register_map import MapError, RegisterMap, build_map
+from twin.frontends.modbus import register_map
+from twin.frontends.modbus.register_map import MapError, RegisterMap, build_map
 
 ROOT = Path(__file__).resolve().parents[2]
 STATIONS = [ROOT / "stations" / n for n in ("ring_rig_plc", "ring_rig", "smart_gripper", "four_finger")]
@@ -142,7 +142,7 @@ def test_reads_are_split_at_the_protocols_limit_of_125_registers():
 
 
 def test_the_serve_parser_takes_the_protocol_numbers_without_importing_the_server():
-    code = ("import sys, twin.modbus.cli as c, twin.modbus.protocol as p; "
-            "print(c.TLS_PORT, c.MAX_CONNECTIONS, 'twin.modbus.server' in sys.modules, 'asyncio' in sys.modules)")
+    code = ("import sys, twin_app.cli_modbus as c, twin.frontends.modbus.protocol as p; "
+            "print(c.TLS_PORT, c.MAX_CONNECTIONS, 'twin.frontends.modbus.server' in sys.modules, 'asyncio' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=60, check=True)
     assert out.stdout.split() == ["802", "64", "False", "False"]

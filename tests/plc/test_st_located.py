@@ -125,7 +125,7 @@ def test_the_st_gripper_plc_behind_an_openplc_like_master_grips_in_real_time():
     cfg = {k: int(v) for k, v in re.findall(r'^device0\.(\w+) = "(\d+)"$', (CELL / "mbconfig.cfg").read_text(), re.M)}
     bit = lambda area, n: f"%{area}X{100 + n // 8}.{n % 8}"  # noqa: E731
     st = load([CELL / "gripper.st", CELL / "io.st"])
-    from twin.modbus.register_map import build_map
+    from twin.frontends.modbus.register_map import build_map
 
     fault_coil = build_map(CELL, "plc")["diGripFault"].address - cfg["Coils_Start"]
     with ServerProcess(CELL, "--realtime", "--layout", "plc") as server:

@@ -1,10 +1,9 @@
 """A station's own code (its demo, its PLC logic) plugs into the general commands through `[plugins]` in its
-station file; old module names of code that moved beside its station still import, with a warning."""
+station file."""
 from __future__ import annotations
 
 import subprocess
 import sys
-import warnings
 
 import pytest
 
@@ -54,38 +53,11 @@ def test_a_demo_shows_its_own_options_under_the_general_command():
     assert r.returncode == 2 and "unrecognized arguments: --no-such-option" in r.stderr
 
 
-def test_the_old_module_names_still_import_the_moved_code_with_a_deprecation_warning():
-    r = run("-W", "error::DeprecationWarning", "-c", "import plc_client.ring_rig")
-    assert r.returncode != 0 and "plc_client.ring_rig has moved to stations.ring_rig_plc.plc_logic" in r.stderr
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        from plc_client import ring_rig
-        from stations.ring_rig_plc import plc_logic
-    assert ring_rig is plc_logic
-    r = run("-c", "import warnings; warnings.simplefilter('ignore'); import twin.demo, plc_client.cell_demo; "
-                  "print(twin.demo.__name__, plc_client.cell_demo.__name__)")
-    assert r.stdout.split() == ["stations.ring_rig.demo", "stations.ring_rig_plc.demo"], r.stderr
-    r = run("-c", "import plc_client.no_such_module")
-    assert "ModuleNotFoundError" in r.stderr  # only what a station declares is found
-
-
-def test_a_campaign_naming_the_old_logic_still_loads(tmp_path):
-    from twin_app.campaign.spec import load_campaign
-
-    text = (CELL / "campaign.toml").read_text().replace("stations.ring_rig_plc.plc_logic:", "plc_client.ring_rig:")
-    text = text.replace('station = "."', f'station = "{CELL.as_posix()}"')
-    assert 'plc = "plc_client.ring_rig:cell_sequence"' in text
-    (tmp_path / "campaign.toml").write_text(text)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        assert load_campaign(tmp_path / "campaign.toml").driver.ref == "plc_client.ring_rig:cell_sequence"
-
-
 @pytest.mark.parametrize("table, key, message", [
     ('twin_dmo = "x.py"', "plugins.twin_dmo", "is not a known key here"),
     ('plc_demo = "two words"', "plugins.plc_demo", 'must be "package.module", "file.py", or either with ":name"'),
     ("plc_logic = 3", "plugins.plc_logic", "must be a string"),
-    ('moved = { "plc_client.x" = 1 }', "plugins.moved.plc_client.x", "must be the module's new name"),
+    ('moved = { "plc_client.x" = "y" }', "plugins.moved", "is not a known key here"),
 ])
 def test_a_bad_plugins_table_names_its_key(tmp_path, table, key, message):
     text = (STATIONS / "smart_gripper" / "station.toml").read_text()
@@ -97,7 +69,7 @@ def test_a_bad_plugins_table_names_its_key(tmp_path, table, key, message):
 
 
 def test_the_shipped_stations_name_their_code_and_it_loads():
-    from twin.plugins import station_plugin
+    from twin_app.plugins import station_plugin
 
     assert callable(station_plugin(CELL, "plc_logic")().inputs.__len__)
     for station, key in ((CELL, "plc_demo"), (STATIONS / "ring_rig", "twin_demo")):

@@ -8,7 +8,7 @@ from conftest import ROOT
 
 from twin.core import Twin
 from twin.core.errors import StationError
-from twin.profiles.robotiq import open_profile
+from twin.devices.robotiq import open_profile
 
 SMART = ROOT / "stations" / "smart_gripper"
 

@@ -9,7 +9,7 @@ import pytest
 from tests.conftest import STATIONS
 from twin_app.cli import main as twin_main
 from twin.core import Twin
-from twin.recording import Recording, record
+from twin.observe.recording import Recording, record
 
 pytest.importorskip("matplotlib")
 pytest.importorskip("pyarrow")
@@ -101,7 +101,7 @@ def test_snapshot_outside_the_recording_is_refused(grip_recording, tmp_path, cap
 
 
 def test_report_has_a_picture_per_grip_and_release(grip_recording, tmp_path):
-    from twin.report import write_report
+    from twin.observe.report import write_report
 
     index = write_report(grip_recording, tmp_path / "report", width=320, height=240)
     html = index.read_text()

@@ -9,7 +9,7 @@ import pytest
 from plc_client.testing import twin_server
 from tests.conftest import STATIONS
 from twin.core import Twin
-from twin.recording import Recording, RecordingError, record
+from twin.observe.recording import Recording, RecordingError, record
 
 SMART = STATIONS / "smart_gripper"
 RING = STATIONS / "ring_rig_plc"
@@ -97,7 +97,7 @@ def test_a_sigkilled_server_leaves_every_step_but_the_last_second_readable(tmp_p
     pytest.importorskip("pyarrow")
     import signal
 
-    from twin.recording import finish
+    from twin.observe.recording import finish
 
     path = tmp_path / f"crash.{suffix}"
     with twin_server(RING, lockstep=True, extra_args=["--record", str(path)]) as server:

@@ -11,7 +11,7 @@ from plc_client.events import EventLog
 from tests.conftest import ROOT, STATIONS
 from tests.view.conftest import signal_cell, wait_for_cell
 from twin.core import Twin
-from twin.recording import record
+from twin.observe.recording import record
 
 
 @pytest.fixture(scope="module")

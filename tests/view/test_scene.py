@@ -8,7 +8,7 @@ import pytest
 from tests.conftest import PYBULLET_DATA, STATIONS
 from tests.core.test_foreign_models import robot_station
 from twin.core import Twin
-from twin.observe import Observer, pose_matrix, setpoint_motion
+from twin.observe.scene import Observer, pose_matrix, setpoint_motion
 
 
 def test_the_ghost_of_a_finger_is_where_the_finger_goes():
@@ -35,7 +35,7 @@ def test_the_ghost_of_a_finger_is_where_the_finger_goes():
 
 def test_mesh_visuals_are_found_and_load(tmp_path):
     pytest.importorskip("trimesh")
-    from twin.view.page import _load_mesh
+    from twin.frontends.view.page import _load_mesh
 
     path = robot_station(tmp_path, gripper=PYBULLET_DATA / "franka_panda" / "panda.urdf")  # under the arm
     with Twin.from_station(path) as twin:

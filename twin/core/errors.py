@@ -11,10 +11,10 @@
     └── MotionError               the robot cannot reach a target (names the target)
 
 Defined above the core, where they are found, and deriving from `TwinError` (the core imports none of them):
-`twin.exchange.SimulationFault` (the simulation stopped on an error), `twin.faults.FaultError` (a plant fault
-that cannot act), `twin.plugins.LoadError` (a station's plug-in), `twin.recording.RecordingError`,
-`twin.modbus.register_map.MapError`, `twin.opcua.security.SecurityError`, `twin.opcua.address_space.
-AddressSpaceError`, `twin.opcua.errors.AdvanceRefused`, `twin_app.campaign.spec.SpecError` (and its
+`twin.runtime.exchange.SimulationFault` (the simulation stopped on an error), `twin.runtime.faults.FaultError` (a plant fault
+that cannot act), `twin_app.plugins.LoadError` (a station's plug-in), `twin.observe.recording.RecordingError`,
+`twin.frontends.modbus.register_map.MapError`, `twin.frontends.opcua.security.SecurityError`, `twin.frontends.opcua.address_space.
+AddressSpaceError`, `twin.frontends.opcua.errors.AdvanceRefused`, `twin_app.campaign.spec.SpecError` (and its
 `ExpressionError`), `twin_app.campaign.scenario.ScenarioError`, `rapid_like.errors.RapidError` (FILE:LINE:COL),
 `structured_text.errors.StError` (FILE:LINE:COL), `plc_client.errors.PlcClientError`.
 

@@ -55,7 +55,7 @@ SIM_ADVANCE, SIM_STEP, SIM_TIME_MS, SIM_LATE_STEPS, SIM_DT_US, SIM_MODE, SIM_SPE
     "sim.advance", "sim.step", "sim.time_ms", "sim.late_steps", "sim.dt_us", "sim.mode", "sim.speed_pct",
     "sim.map_crc")
 SIM_FAULT, SIM_LOCKSTEP, SIM_LATE = "fault", "sim.lockstep", "sim.late"
-WATCHDOG_MS, COMM_LOST = "comm.watchdog_ms", "comm.lost"  # the comm-loss watchdog (twin.watchdog)
+WATCHDOG_MS, COMM_LOST = "comm.watchdog_ms", "comm.lost"  # the comm-loss watchdog (twin.runtime.watchdog)
 U32_MAX = float(0xFFFFFFFF)
 U16_MAX = 0xFFFF
 
@@ -188,7 +188,7 @@ def twin_signals(station: Station, mechanism: Mechanism | None = None) -> tuple[
 
 
 def watchdog_signals(safe_state: str = "hold") -> tuple[SignalSpec, ...]:
-    """The comm-loss watchdog's output (`twin.watchdog`, in every cell; off until it has a time)."""
+    """The comm-loss watchdog's output (`twin.runtime.watchdog`, in every cell; off until it has a time)."""
     return (SignalSpec(COMM_LOST, OUTPUT, BOOL, group=SIM,
                        description="comm-loss watchdog: no request from any client for the watchdog time; "
                                    f"the gripper went to its safe state ({safe_state}); cleared by the next request"),)

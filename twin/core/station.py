@@ -136,7 +136,7 @@ class ControllerSpec:
 
 @dataclass(frozen=True)
 class WatchdogSpec:
-    """`[watchdog]`: the comm-loss watchdog (twin.watchdog): seconds of silence, and the safe state."""
+    """`[watchdog]`: the comm-loss watchdog (twin.runtime.watchdog): seconds of silence, and the safe state."""
 
     timeout: float | None = None  # s; None: off unless `twin serve --watchdog S`
     safe_state: str = "hold"  # hold, open or stop
@@ -159,8 +159,8 @@ class Station:
     robot_targets: dict[str, Placement]
     controller: ControllerSpec | None
     watchdog: WatchdogSpec | None = None
-    profile: dict | None = None  # the raw `[profile]` table: read and checked by twin.profiles, not the core
-    plugins: dict[str, str] = field(default_factory=dict)  # `[plugins]`: station code by reference (twin.plugins)
+    profile: dict | None = None  # the raw `[profile]` table: read and checked by twin.devices, not the core
+    plugins: dict[str, str] = field(default_factory=dict)  # `[plugins]`: station code by reference (twin_app.plugins)
 
     @property
     def folder(self) -> Path:
@@ -463,7 +463,7 @@ def load_station(path: str | Path) -> Station:
                                        check=lambda v: None if v in SAFE_STATES else f"must be one of {', '.join(SAFE_STATES)}"),
                                 opened)
         wr.done()
-    profile = top.get("profile", dict, None)  # a device profile's mapping (twin.profiles checks it)
+    profile = top.get("profile", dict, None)  # a device profile's mapping (twin.devices checks it)
     plugins = _plugins(top)
     top.done()
     station = Station(file, name, step, substeps, gravity, gripper, robot, targets, fixtures, robot_targets, controller,
@@ -472,11 +472,11 @@ def load_station(path: str | Path) -> Station:
     return station
 
 
-PLUGIN_KEYS = ("twin_demo", "plc_demo", "plc_logic")  # what each one is: twin.plugins
+PLUGIN_KEYS = ("twin_demo", "plc_demo", "plc_logic")  # what each one is: twin_app.plugins
 
 
 def _plugins(top: _Reader) -> dict[str, str]:
-    """`[plugins]`: references to the station's own code, checked for form only (loading is twin.plugins's)."""
+    """`[plugins]`: references to the station's own code, checked for form only (loading is twin_app.plugins's)."""
     pr = top.sub("plugins", required=False)
     if pr is None:
         return {}
@@ -486,10 +486,6 @@ def _plugins(top: _Reader) -> dict[str, str]:
                      'must be "package.module", "file.py", or either with ":name"')
         if ref is not None:
             plugins[key] = ref.strip()
-    moved = pr.get("moved", dict, {})  # old module name -> new one (twin.moved): kept for imports, not here
-    bad = [k for k, v in moved.items() if not isinstance(v, str)]
-    if bad:
-        raise pr.error(f"moved.{bad[0]}", "must be the module's new name (a string)")
     pr.done()
     return plugins
 

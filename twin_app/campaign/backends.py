@@ -192,7 +192,7 @@ class LocalBackend:
         self.workers, self.timeout = int(workers), timeout
 
     def run(self, campaign, indices: Iterable[int], on_result: OnResult, record: dict | None = None) -> None:
-        """`record`: index -> a file to record that scenario's run into (twin.recording)."""
+        """`record`: index -> a file to record that scenario's run into (twin.observe.recording)."""
         timeout = self.timeout if self.timeout is not None else campaign.timeout
         pending = list(indices)
         record = record or {}

@@ -9,7 +9,7 @@ import argparse
 import os
 import sys
 
-from twin.cli_args import positive_float
+from twin_app.cli_args import positive_float
 from pathlib import Path
 
 
@@ -71,7 +71,7 @@ def with_plc(campaign, ref: str):
             raise SpecError(campaign.file, "driver.plc", f"--plc: {missing[0]}: no such file in {campaign.driver.base}")
         ref = " ".join(st_files(ref))
     else:
-        from twin.plugins import LoadError, load_object
+        from twin_app.plugins import LoadError, load_object
 
         try:
             load_object(ref, campaign.driver.base)

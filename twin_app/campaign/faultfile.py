@@ -21,7 +21,7 @@ from .spec import LINK_KINDS, SpecError, _fault, _Station, read_toml
 
 def load_fault_file(path: str | Path, twin) -> list:
     """The plant faults of `path`, checked against `twin`'s station (SpecError naming file and key)."""
-    from twin.faults import FaultError
+    from twin.runtime.faults import FaultError
 
     from .scenario import ScenarioError, build_faults
 

@@ -102,8 +102,8 @@ def run_campaign(campaign: Campaign, backend, out_dir: str | Path, *, resume: bo
 
 
 def _record_failures(campaign: Campaign, out: Path, records: list[dict], limit: int) -> list[int]:
-    """Run each failing scenario once more, recorded (twin.recording: every signal and body pose at every
-    step, as CSV), and plot it when matplotlib is installed (twin.plot): `failures/NNNN.csv`, `.png`. The
+    """Run each failing scenario once more, recorded (twin.observe.recording: every signal and body pose at every
+    step, as CSV), and plot it when matplotlib is installed (twin.observe.plot): `failures/NNNN.csv`, `.png`. The
     runs are deterministic, so the re-run is the failing run. Crashed and hung scenarios are not re-run."""
     from .backends import LocalBackend
 
@@ -127,8 +127,8 @@ def _plot(path: Path, record: dict, campaign: Campaign) -> None:
         import matplotlib  # noqa: F401
     except ImportError:
         return
-    from twin.plot import plot_recording
-    from twin.recording import Recording
+    from twin.observe.plot import plot_recording
+    from twin.observe.recording import Recording
 
     if not path.exists():
         return

@@ -12,7 +12,7 @@ import dataclasses
 import math
 from typing import Any
 
-from twin.plugins import load_object
+from twin_app.plugins import load_object
 from .spec import Campaign, Scenario
 from twin.core.device import ObservingDevice
 from twin.core.errors import TwinError
@@ -102,7 +102,7 @@ def fault_names(params: dict) -> list[str]:
 
 def build_faults(campaign: Campaign, params: dict, twin) -> tuple[list, dict]:
     """The scenario's plant faults (for `FaultInjector`) and its link faults (for `LinkFaults`)."""
-    from twin import faults as F
+    from twin.runtime import faults as F
 
     plant, link = [], {"lost": [], "latency": 0.0, "jitter": 0.0, "seed": 0}
     for name in fault_names(params):
@@ -275,7 +275,7 @@ def make_logic(campaign: Campaign, params: dict, station=None):
 
     if st_files(campaign.driver.ref):  # a Structured Text PLC on the station's PLC layout; plc.NAME sets its NAME
         from plc_client.st_io import StLogic
-        from twin.modbus.register_map import build_register_map
+        from twin.frontends.modbus.register_map import build_register_map
         from twin.core.signal_table import station_signals
         from structured_text.errors import StError
 
@@ -361,7 +361,7 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
     import time
 
     from twin.core.station import load_station
-    from twin.faults import FaultInjector, FaultError
+    from twin.runtime.faults import FaultInjector, FaultError
     from twin.core.native_output import quiet_native_output
     from twin_app.cell import Cell
 
@@ -396,8 +396,8 @@ def _run(campaign: Campaign, scenario: Scenario, record_to: str | None = None) -
             raise ScenarioError(str(exc)) from None
         monitor = Monitor(twin)
         twin.add_device(monitor)
-        if record_to is not None:  # a recording of every signal and pose at every step (twin.recording)
-            from twin.recording import record
+        if record_to is not None:  # a recording of every signal and pose at every step (twin.observe.recording)
+            from twin.observe.recording import record
 
             stack.enter_context(record(twin, record_to))
         part = campaign.measure.get("part") or (station.targets[0].name if station.targets else None)

@@ -330,7 +330,7 @@ def _driver(file, d: dict) -> Driver:
         raise SpecError(file, "driver.entry", f"must be a routine name, not {entry!r}")
     driver = Driver(kind, ref, entry, scan, file.parent.resolve())
     if kind != "rapid" and not st_files(ref):
-        from twin.plugins import LoadError, load_object
+        from twin_app.plugins import LoadError, load_object
 
         try:
             load_object(ref, driver.base)

@@ -22,7 +22,7 @@ import plc_client.link  # noqa: E402,F401
 import plc_client.scan  # noqa: E402,F401
 import rapid_like.station_host  # noqa: E402,F401
 import twin.core  # noqa: E402,F401
-import twin.faults  # noqa: E402,F401
+import twin.runtime.faults  # noqa: E402,F401
 
 from .scenario import LAST_TIMING, run_scenario  # noqa: E402
 
