@@ -12,7 +12,7 @@ from twin.core.signals import INPUT
 DOC = ROOT / "docs" / "signals.md"
 # shipped stations and test grippers nobody tuned: prismatic and revolute fingers, mimic pairs, a robot, a controller
 STATION_DIRS = [STATIONS / "ring_rig_plc", STATIONS / "smart_gripper", STATIONS / "four_finger",
-                ROOT / "tests" / "core" / "data" / "chuck3", *sorted((ROOT / "tests" / "grippers").glob("*/"))]
+                ROOT / "tests" / "core" / "data" / "chuck3", *sorted(p.parent for p in (ROOT / "tests" / "grippers").glob("*/station.toml"))]
 
 
 def documented() -> list[str]:
