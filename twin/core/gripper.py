@@ -214,12 +214,13 @@ class Gripper:
         # pybullet_utils' client looks every function up anew on each call: the per-substep ones are bound once
         self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
         self._contact_points = client.getContactPoints
+        self._target_ids = list(targets.values())
+        self._link_keys = {(link, uid): (finger, uid) for link, finger in self._finger_of_link.items()
+                           for uid in self._target_ids}  # a contact's (finger link, target): its force's key
         self._quiet = False
         # the joints' states as last read (after the last physics substep: what the next drive starts from), and
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
         self._states = None
-        self._speeds = [0.0] * len(self.names)  # each joint's speed over the last physics substep(s) measured
-        self._ticks = 0  # physics substeps since the joints were last read
         self._step_positions: list[float] | None = None  # the joints' positions at the end of the last step
         self._step_ticks = 0  # physics substeps since the last sense
         self._sent: tuple | None = None
@@ -452,7 +453,6 @@ class Gripper:
         Drives that all stand still at their goal, pressing on nothing, keep the first substep's settings for the
         rest of the step: nothing changes there but cost. The joints' states are those `measure` read after the
         substep before (nothing moves the joints in between)."""
-        self._ticks += 1
         self._step_ticks += 1
         if substep and self._quiet:
             return
@@ -468,12 +468,12 @@ class Gripper:
         velocities, forces = [], []
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
-        fingers, axes = self.state.fingers, self.state.axes  # as the last step left them
+        axes, presses, series = self.state.axes, self._presses, self._series  # as the last step left them
         for (name, _, moving), (actual, joint_speed, _, _) in zip(self._per_input, states):
             d = drives[name]
             g = goal[name]
             before = command[name]
-            pressing = any(fingers[f].force > 0.0 for f in self._fingers_of_servo[name] if f in fingers)  # last step
+            pressing = presses[name]  # a finger it moves pressed on a part in the last step
             if name in turned:
                 turned.discard(name)
                 if (g - actual) * (before - actual) < 0.0:
@@ -506,7 +506,7 @@ class Gripper:
             error = target - actual
             toward = joint_speed if error > 0.0 else -joint_speed
             speed = error / h  # to be at the command after the substep, as far as the force allows
-            if self._series[name] > 1 and pressing:
+            if series[name] > 1 and pressing:
                 # drives in series on one pressed finger (a fine axis on its carriage): the part holds their sum, and
                 # what moves between them is their own links alone, not the part: each taking its whole error out
                 # in one substep throws the pair against each other (every substep, the part standing); each takes
@@ -552,28 +552,18 @@ class Gripper:
         if self._quiet and not last:
             return
         self._n += 1
-        before = self._states
         states = self._states = self._joint_states(self.body, self._joint_ids)
-        if before is not None:  # how fast each joint moved, from its positions: pybullet's joint velocity reads the
-            # motor's target where a contact or a stop holds the joint back by position correction
-            elapsed = self._ticks * self.h
-            self._speeds = [(s[0] - b[0]) / elapsed for s, b in zip(states, before)]
-        self._ticks = 0
-        efforts = self._effort_sum
-        for i, s in enumerate(states):
-            efforts[i] += s[3]
-        sums, finger_of, contact_points = self._force_sum, self._finger_of_link, self._contact_points
+        self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
+        sums, keys, contact_points, body = self._force_sum, self._link_keys, self._contact_points, self.body
         self._joint_frames.clear()
-        for uid in self.targets.values():
-            for pt in contact_points(self.body, uid):
-                finger = finger_of.get(pt[3])
-                if finger is None or pt[9] <= 0.0:
+        for uid in self._target_ids:
+            for pt in contact_points(body, uid):
+                if pt[9] <= 0.0:
                     continue
-                if finger in self.revolute_fingers:
-                    force = abs(self._torque(finger, pt))
-                else:
-                    force = pt[9]
-                key = (finger, uid)
+                key = keys.get((pt[3], uid))
+                if key is None:  # not a finger link
+                    continue
+                force = abs(self._torque(key[0], pt)) if key[0] in self.revolute_fingers else pt[9]
                 sums[key] = sums.get(key, 0.0) + force
 
     def _torque(self, finger: str, pt) -> float:
@@ -623,6 +613,7 @@ class Gripper:
             force = sum(on.values())
             fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
         self.state.fingers = fingers
+        self._presses = {name: any(fingers[f].force > 0.0 for f in fs) for name, fs in self._fingers_of_servo.items()}
         self._reset_sums()
 
         held = self.state.gripped

@@ -19,6 +19,7 @@ from rest to rest.
 """
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 from typing import Callable, Iterable, Sequence
@@ -188,6 +189,7 @@ class Trajectory:
         self._knots = np.array(knots, dtype=float)  # shape (n + 1, axes): q at path parameter s_knots[i]
         self._n = len(self._knots) - 1
         self._s = np.linspace(0.0, 1.0, self._n + 1) if s_knots is None else np.array(s_knots, dtype=float)
+        self._s_list = self._s.tolist()  # (looked up at every physics substep: bisect on a list beats numpy's search)
         self.profile = profile
         self.duration = profile.duration
         self.path = path
@@ -206,8 +208,8 @@ class Trajectory:
         """q and dq/ds at path parameter s (linear between knots)."""
         if self._n == 0:
             return self._knots[0].copy(), np.zeros(self._knots.shape[1])
-        i = min(max(int(np.searchsorted(self._s, s, side="right")) - 1, 0), self._n - 1)
-        s0, s1 = self._s[i], self._s[i + 1]
+        i = min(max(bisect.bisect_right(self._s_list, s) - 1, 0), self._n - 1)
+        s0, s1 = self._s_list[i], self._s_list[i + 1]
         a, b = self._knots[i], self._knots[i + 1]
         f = (s - s0) / (s1 - s0)
         return a + f * (b - a), (b - a) / (s1 - s0)

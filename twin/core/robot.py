@@ -340,8 +340,11 @@ class Robot:
     def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
         n = len(self.joints)
         self._held = None
-        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL,
-                                              targetPositions=[float(v) for v in q],
-                                              targetVelocities=[float(v) for v in qd],
-                                              forces=self.forces, positionGains=[self.position_gain] * n,
-                                              velocityGains=[self.velocity_gain] * n)
+        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=_floats(q),
+                     targetVelocities=_floats(qd), forces=self.forces, positionGains=[self.position_gain] * n,
+                     velocityGains=[self.velocity_gain] * n)
+
+
+def _floats(values) -> list[float]:
+    """Python floats for pybullet (an array's `tolist` gives the very same values, without a loop in Python)."""
+    return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]
