@@ -614,6 +614,7 @@ class Gripper:
             fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
         self.state.fingers = fingers
         self._presses = {name: any(fingers[f].force > 0.0 for f in fs) for name, fs in self._fingers_of_servo.items()}
+        self.pressing = any(f.force > 0.0 for f in fingers.values())  # a finger pressed on a part in this step
         self._reset_sums()
 
         held = self.state.gripped

@@ -127,6 +127,7 @@ class Twin:
             # the drives and the arm are commanded at every physics substep: an arm command held for a whole
             # step moves the flange in bursts that shake a friction grip loose (measured-facts.md)
             t, h, gripper, robot, world = self.time, self.world.substep, self.gripper, self.robot, self.world
+            world.solve_for(gripper.pressing or bool(gripper.state.gripped or gripper.state.attached))
             for k in range(world.substeps):
                 gripper.drive(k)
                 if robot is not None:

@@ -34,8 +34,9 @@ CYLINDER_MARGIN = 0.001  # m: pybullet's own, kept for cylinders (rims round by 
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
 SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
 # rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
-RESIDUAL_SHARE = 2e-3  # ... fewer once converged: the solver stops when no contact's or drive's impulse changes by more
-# than this share of the lightest loose body's weight over a substep in one sweep (`solver_tolerance`)
+RESIDUAL_SHARE = 2e-3  # ... fewer once converged while fingers press on a part: the solver stops when no contact's or
+# drive's impulse changes by more than this share of the lightest loose body's weight over a substep in one sweep
+PYBULLET_RESIDUAL = 1e-7  # pybullet's own threshold (its measure: an impulse's change squared), kept at every other time
 
 
 def _mm(xyz) -> str:
@@ -291,9 +292,9 @@ def bind_calls(client: BulletClient) -> None:
 
 
 def solver_tolerance(station: Station, substep: float) -> float | None:
-    """N s: the change of impulse per sweep below which the solver has converged: RESIDUAL_SHARE of the lightest
-    loose body's weight over a substep (a resting or held part's statics hold to that share). None: no loose body
-    under gravity to scale by: pybullet's own threshold stays."""
+    """N s: the change of impulse per sweep below which the solver has converged on a squeeze: RESIDUAL_SHARE of the
+    lightest loose body's weight over a substep (a held part's statics hold to that share). None: no loose body under
+    gravity to scale by: pybullet's own threshold stays."""
     g = math.sqrt(sum(v * v for v in station.gravity))
     masses = [b.mass for b in (*station.fixtures, *station.targets) if b.dynamic]
     if not masses or g == 0.0:
@@ -357,8 +358,10 @@ class World:
         c.setPhysicsEngineParameter(fixedTimeStep=self.substep, numSubSteps=1, numSolverIterations=SOLVER_ITERATIONS,
                                     deterministicOverlappingPairs=1)
         tolerance = solver_tolerance(st, self.substep)
-        if tolerance is not None:  # (the solver's measure is the largest squared change of an impulse in a sweep)
-            c.setPhysicsEngineParameter(solverResidualThreshold=tolerance ** 2)
+        # (the solver's measure is the largest squared change of an impulse in a sweep)
+        self._residuals = (PYBULLET_RESIDUAL, PYBULLET_RESIDUAL if tolerance is None else tolerance ** 2)
+        self._pressing = False
+        c.setPhysicsEngineParameter(solverResidualThreshold=PYBULLET_RESIDUAL)
 
     def _create_body(self, body: Body) -> int:
         return create_body(self.client, body)
@@ -371,6 +374,14 @@ class World:
         self.probe = ContactProbe(self.client, self.machine, finger_links, targets,
                                   lambda client, name: create_body(client, spec[name]))
         return self.probe
+
+    def solve_for(self, pressing: bool) -> None:
+        """The solver's tolerance for the next step: `solver_tolerance` while fingers press on a part (a squeeze's
+        statics hold to it, and it costs half the iterations), pybullet's own otherwise (a drive standing at its goal
+        settles exactly, and the cell at rest freezes: stasis.py)."""
+        if pressing != self._pressing:
+            self._pressing = pressing
+            self.client.setPhysicsEngineParameter(solverResidualThreshold=self._residuals[pressing])
 
     def substep_physics(self) -> None:
         """One physics substep (a simulation step is `substeps` of them)."""
