@@ -298,3 +298,28 @@ initial = { left_gripper = 0.5, right_gripper = 0.5 }
 """)
     with Twin.from_station(tmp_path) as twin:
         assert twin.gripper.closing == geometry
+
+
+@pytest.mark.parametrize("rise", [None, 0.15])
+def test_a_pressing_drive_builds_its_force_within_the_force_rise_time(tmp_path, rise):
+    """docs/station-format.md, Drives: a finger stalled on a part reaches its effort within the force rise time (50 ms,
+    or the station's `[gripper] force_rise_time`), not at its velocity limit's pace (the newcomer's 40 N at 50 mm/s
+    and 3.5 N/mm would take 0.23 s)."""
+    src = GRIPPERS["newcomer_2f"]
+    text = (src / "station.toml").read_text()
+    text = text.replace('urdf = "newcomer_2f.urdf"', f'urdf = "{src / "newcomer_2f.urdf"}"')
+    text = text.replace('urdf = "../../../stations/robots/arm6700.urdf"',
+                        f'urdf = "{(src / "../../../stations/robots/arm6700.urdf").resolve()}"')
+    if rise is not None:
+        text = text.replace("always_active = true", f"always_active = true\nforce_rise_time = {rise}")
+    (tmp_path / "station.toml").write_text(text)
+    rise = rise or 0.05
+    with Twin.from_station(tmp_path) as twin:
+        _, touched = close_on_part(twin, "newcomer_2f")
+        forces = []
+        for _ in range(round(0.4 / twin.dt)):
+            twin.step()
+            forces.append(min(twin.read(f"{f}.force") for f in GRIPS["newcomer_2f"].force))
+        full = next(k for k, f in enumerate(forces, 1) if f >= 0.9 * 40.0) * twin.dt  # s after the touching step
+        assert full <= rise + 2 * twin.dt
+        assert full >= 0.5 * rise  # no faster than it says either

@@ -2,7 +2,7 @@
 
 The drive model (docs/station-format.md, "Drives"). Every input is a servo drive:
 - its *command* moves towards the setpoint at the velocity limit (a ramp; while its finger presses on a part, at
-  least fast enough to reach full force within 50 ms), and runs ahead of the joint by no more
+  least fast enough to reach full force within the force rise time, 50 ms unless the station says), and runs ahead of the joint by no more
   than the error at which the drive reaches its force limit, so a new setpoint acts at once;
 - a position loop of stiffness K and damping D asks for |K e - D v| (+ a small holding force), e = command - actual,
   v the joint's speed, limited by the effort; within that force pybullet's implicit velocity motor drives the joint
@@ -66,7 +66,10 @@ LATCH_FRACTION = 0.975  # a drive pressing with this share of its full-force err
 # (K e + the holding force: 99.5 % of its effort), and the rest of its effort holds the finger where it stands; a part
 # that gives way is followed back to that error (the force stays), one that pushes back meets up to the whole effort
 FORCE_RISE_TIME = 0.05  # s: a drive whose finger presses on a part runs its command on at least this fast to full force
-# (a slow drive would build it over `full error / velocity`, 0.23 s on 40 N at 50 mm/s, while the pair drifts)
+# (a slow drive would build it over `full error / velocity`, 0.23 s on 40 N at 50 mm/s, while the pair drifts). A model
+# parameter, not derived: half the position loop's period on what it moves, pi sqrt(m / K) (13 ms on the test
+# grippers), or its whole period, lets two 40 N fingers on a 300 g steel cylinder rock it (status 0 again 15 to 41
+# steps after touching); 50 ms (4 steps) holds every test gripper. The station's `[gripper] force_rise_time` overrides it
 FOLLOW_FRACTION = 0.965  # ... once the error has fallen below this share (both springs of a squeezed pair hold it)
 RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
@@ -171,6 +174,7 @@ class Gripper:
         self._fingers_of_servo = {name: [f for f, servos in self.finger_servos.items() if name in servos]
                                   for name in self.names}
         self._derive_drives(stiffness_given)
+        self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
         self.effort_notes = self._unreachable_efforts()
         # how many springy drives move each drive's fingers in series (a fine axis and the carriage it rides on: 2;
         # a drive stiffer than the step resolves holds its command rigidly, and is no spring in the chain)
@@ -491,7 +495,7 @@ class Gripper:
                 way = None
                 rate = d.velocity
                 if (before - actual) * (g - actual) > 0.0 and pressing:
-                    rate = max(rate, full / FORCE_RISE_TIME)  # pressing on a part: full force within 50 ms
+                    rate = max(rate, full / self.rise_time)  # pressing on a part: full force within 50 ms
                 target = _towards(before, g, rate * h)
             # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
             target = min(max(target, actual - full), actual + full)

@@ -95,6 +95,7 @@ class GripperSpec:
     grip_force: float | None = None  # N (N*m): doGripped's per-finger threshold; None: 10 % of the finger's effort
     attach_force: float | None = None  # N (N*m): attach mode's threshold; None: grip_force
     slip_distance: float = 0.005  # m: a gripped part moved this far relative to the base link has slipped
+    force_rise_time: float | None = None  # s: a drive pressing on a part reaches its effort within this (None: 0.05)
 
 
 @dataclass(frozen=True)
@@ -372,6 +373,7 @@ def load_station(path: str | Path) -> Station:
         grip_force=g.number("grip_force", None, positive=True),
         attach_force=g.number("attach_force", None, positive=True),
         slip_distance=g.number("slip_distance", 0.005, positive=True),
+        force_rise_time=g.number("force_rise_time", None, positive=True),
     )
     g.done()
 
