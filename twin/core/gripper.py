@@ -218,9 +218,9 @@ class Gripper:
         # pybullet_utils' client looks every function up anew on each call: the per-substep ones are bound once
         self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
         self._contact_points = client.getContactPoints
-        self._target_ids = list(targets.values())
-        self._link_keys = {(link, uid): (finger, uid) for link, finger in self._finger_of_link.items()
-                           for uid in self._target_ids}  # a contact's (finger link, target): its force's key
+        self._link_keys = {(link, uid): ((finger, uid), finger in self.revolute_fingers)
+                           for link, finger in self._finger_of_link.items()
+                           for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
         self._quiet = False
         # the joints' states as last read (after the last physics substep: what the next drive starts from), and
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
@@ -558,17 +558,18 @@ class Gripper:
         self._n += 1
         states = self._states = self._joint_states(self.body, self._joint_ids)
         self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
-        sums, keys, contact_points, body = self._force_sum, self._link_keys, self._contact_points, self.body
+        sums, keys = self._force_sum, self._link_keys
         self._joint_frames.clear()
-        for uid in self._target_ids:
-            for pt in contact_points(body, uid):
-                if pt[9] <= 0.0:
-                    continue
-                key = keys.get((pt[3], uid))
-                if key is None:  # not a finger link
-                    continue
-                force = abs(self._torque(key[0], pt)) if key[0] in self.revolute_fingers else pt[9]
-                sums[key] = sums.get(key, 0.0) + force
+        for pt in self._contact_points(self.body):  # one query for all of the machine's contacts (a crowded cell's
+            # parts that touch nothing cost nothing), its finger links' on targets kept
+            if pt[9] <= 0.0:
+                continue
+            key = keys.get((pt[3], pt[2]))
+            if key is None:  # not a finger link on a target
+                continue
+            key, revolute = key
+            force = abs(self._torque(key[0], pt)) if revolute else pt[9]
+            sums[key] = sums.get(key, 0.0) + force
 
     def _torque(self, finger: str, pt) -> float:
         """The torque about a revolute finger's joint axis of one contact's force (normal and friction) on the part."""
