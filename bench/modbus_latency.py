@@ -62,8 +62,9 @@ class Server:
         threading.Thread(target=drain, daemon=True).start()
         if port_from_events:
             self.events = EventLog(path, self.proc)
-            if self.events.wait("ready", 120) is not None:
-                self.port = next((f["port"] for f in self.events.seen[-1]["front_ends"] if f["name"] == "modbus"), None)
+            ready = self.events.wait("ready", 120)
+            if ready is not None:
+                self.port = next((f["port"] for f in ready["front_ends"] if f["name"] == "modbus"), None)
         end = time.monotonic() + 30
         while True:
             try:

@@ -22,7 +22,7 @@ def run(coro):
 def quiet_client(url: str, name: str) -> Client:
     """A client that sends nothing on its own: asyncua's keep-alive probe (a read every second) is off."""
     c = Client(url, timeout=30, watchdog_intervall=3600)
-    c.description = name  # the session is "NAME Session1"
+    c.description = name
     return c
 
 
@@ -86,8 +86,8 @@ def test_opcua_sessions_feed_the_watchdog_and_a_silent_one_lets_comm_lost_rise()
         assert (first, after) == (True, False)
         line = server.wait_for(r"comm lost: no request for (\S+) s .*last from (.*)\); comm\.lost raised")
         assert line.group(1) == "0.108"  # fired at the first step 0.1 s after the read: 9 steps of 12 ms
-        assert re.fullmatch(r"opcua 127\.0\.0\.1:\d+ session \d+ 'silent-plc Session1'", line.group(2))
-        server.wait_for(r"comm restored: request from opcua 127\.0\.0\.1:\d+ session \d+ 'silent-plc Session1'")
+        assert re.fullmatch(r"opcua 127\.0\.0\.1:\d+", line.group(2))  # the silent client's address (anonymous)
+        server.wait_for(rf"comm restored: request from {re.escape(line.group(2))}")
         assert len(comm_lost_lines(server)) == 1
         assert start == 2 * CHUNKS * CHUNK  # the silent client came after both active ones
 

@@ -30,7 +30,9 @@ setting of the simulation's process. `twin.runtime.pacing` is the only module th
   as the same error type (`SignalRangeError`, `SignalTypeError`, `SimulationFault`, ...) with the same
   message, so each front end maps it to its protocol by type. `await remote.advance(n)` (lockstep) returns
   the step count when n more steps are done; `remote.feed(source, clock_only)` feeds the comm-loss
-  watchdog; `remote.control(action)` pauses, resumes or steps the runner (the page's buttons).
+  watchdog; `remote.control(action)` pauses, resumes or steps the runner (the page's buttons);
+  `remote.event(kind, **fields)` hands a client's coming and going (`client_connected`, `client_gone`,
+  `client_refused`) to the cell's one events writer (`twin serve --events`), stamped with its step there.
 - One ordered channel each way, so a write answered before a `Sim.Advance` is applied in the advance's first
   step: lockstep runs stay bit for bit. The simulation's side never waits for the process: it reads the
   channel in its event loop (no thread) and its writes are buffered by asyncio; a process that stops
@@ -50,6 +52,7 @@ from __future__ import annotations
 
 import asyncio
 import importlib
+import inspect
 import logging
 import multiprocessing
 import os
@@ -70,6 +73,7 @@ log = logging.getLogger("twin.frontends.process")
 MAX_BACKLOG = 64 << 20  # bytes queued for a process that does not read them: then it is cut off
 START_TIMEOUT = 60.0  # s a process may take to start its front end
 RUNNER_ACTIONS = ("pause", "resume", "single_step", "request")
+CLIENT_EVENTS = ("client_connected", "client_gone", "client_refused")  # what a front end's process may report
 _HEADER = struct.Struct("!I")
 
 
@@ -322,6 +326,11 @@ class FrontEndProcess:
                 self.local.on_message(msg[1])
         elif kind == "log":
             self.cell.log(msg[2], msg[1])
+        elif kind == "event":
+            _, event, fields = msg
+            events = getattr(self.cell, "events", None)
+            if event in CLIENT_EVENTS and events is not None:
+                events.emit(event, **fields)
         elif kind == "bye":
             self.requests = msg[1]
             if not self._bye.done():
@@ -394,8 +403,9 @@ class Remote:
         except KeyError:
             raise SignalError(name, "no such signal") from None
 
-    def subscribe(self, on_snapshot: Callable[[RemoteSnapshot], None]) -> Callable[[], None]:
-        """`on_snapshot(snapshot)` for every step, in order, in this process's event loop."""
+    def subscribe(self, on_snapshot: Callable[[RemoteSnapshot], object]) -> Callable[[], None]:
+        """`on_snapshot(snapshot)` for every step, in order, in this process's event loop; a coroutine function
+        is awaited before the next message from the cell is read (so its steps stay in order)."""
         self._subscribers.append(on_snapshot)
         return lambda: self._subscribers.remove(on_snapshot) if on_snapshot in self._subscribers else None
 
@@ -427,6 +437,11 @@ class Remote:
         """A line in the simulation's log (as it is: say whose it is)."""
         self._send(("log", level, text))
 
+    def event(self, kind: str, **fields) -> None:
+        """A client connected, refused or gone (`CLIENT_EVENTS`): an event of `twin serve --events`, with the
+        step and simulated time of the cell when it gets there."""
+        self._send(("event", kind, fields))
+
     async def _ask(self, kind: str, arg):
         self._next += 1
         i = self._next
@@ -439,12 +454,18 @@ class Remote:
         if not self._writer.is_closing():
             self._writer.write(_frame(msg))
 
-    def _snap(self, step: int, time: float, changed: dict, applied: int) -> None:
+    async def _snap(self, step: int, time: float, changed: dict, applied: int) -> None:
         self._values.update(changed)
         self.applied = applied
         self.snapshot = RemoteSnapshot(step, time, MappingProxyType(dict(self._values)))
         for f in tuple(self._subscribers):
-            f(self.snapshot)
+            try:
+                done = f(self.snapshot)
+                if inspect.isawaitable(done):
+                    await done
+            except Exception as exc:  # noqa: BLE001 - one step's trouble, said in one line; the next step comes
+                self.log(f"{self.name}: step {step} could not be published: {type(exc).__name__}: {exc}",
+                         logging.ERROR)
 
     def _reply(self, i: int, reply: tuple) -> None:
         fut = self._replies.pop(i, None)
@@ -484,7 +505,8 @@ async def _child(target: str, sock: socket.socket) -> None:
                 msg = await _read(reader)
                 kind = msg[0]
                 if kind == "snap":
-                    remote._snap(*msg[1:])
+                    await remote._snap(*msg[1:])
+                    await asyncio.sleep(0)  # clients are answered between two steps, even when steps queue up
                 elif kind == "reply":
                     remote._reply(msg[1], msg[2])
                 elif kind == "local":

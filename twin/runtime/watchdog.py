@@ -1,7 +1,7 @@
 """The comm-loss watchdog: when the cell's controllers fall silent, the cell goes to a safe state.
 
 A cell-level piece, fed by any front end: the Modbus server calls `feed("modbus 10.0.0.5:50312")` for
-every request it answers, the OPC UA server `feed("opcua 127.0.0.1:50312 session 11 'PLC1 Session1'")` for
+every request it answers, the OPC UA server `feed("opcua 127.0.0.1:50312 user 'plc1'")` for
 every request of a session. The watchdog keeps a
 "last request seen" per source; the link counts as lost when **no source** has sent a request for
 `timeout` seconds (it is armed by the first request: a cell nobody has talked to yet is not "lost").

@@ -14,10 +14,11 @@ shares the simulation's interpreter. Through `Remote` (the adapter's view of the
   answered when its steps are done. Every request of a session feeds the comm-loss watchdog.
 - one ordered channel: a write answered before a `Sim.Advance` is applied in the advance's first step, and
   what a client reads after an advance is its last step's: lockstep runs stay bit for bit.
+- OPC UA clients coming and going (`sessions`) are handed to the cell as `client_connected` / `client_gone`
+  events, which the simulation's one events writer writes (`twin serve --events`), and logged there.
 """
 from __future__ import annotations
 
-import gc
 import logging
 from collections.abc import Sequence
 
@@ -59,6 +60,17 @@ class RemoteLink:
     def feed(self, source: str, clock_only: bool = False) -> None:
         self.remote.feed(source, clock_only)
 
+    def client(self, kind: str, **fields) -> None:
+        """A client connected or gone (`sessions`): the event to the cell's events, a line to its log."""
+        self.remote.event(kind, **fields)
+        who = fields["peer"] + (f" as {fields['user']!r}" if fields.get("user") else "")
+        if kind == "client_connected":
+            access = "read only" if fields.get("access") == "read" else "read/write"
+            self.remote.log(f"OPC UA: client {who} connected ({access}; {fields['connected']} connected)", logging.INFO)
+        else:
+            self.remote.log(f"OPC UA: client {who} disconnected ({fields['reason']}; {fields['connected']} connected)",
+                            logging.INFO)
+
 
 class OpcUaProcess:
     """The OPC UA front end as the adapter runs it in its own process (`process(options)`)."""
@@ -78,7 +90,7 @@ class OpcUaProcess:
         space = build_address_space(remote.signals, remote.station)
         server = OpcUaServer(space, step_s=remote.dt, submit=link.submit, advance=link.advance,
                              security=o["security"], on_request=link.feed if o["watchdog"] else None,
-                             clock_requests=remote.lockstep)
+                             clock_requests=remote.lockstep, on_client=link.client)
         from .security import SecurityError
 
         try:
@@ -94,18 +106,17 @@ class OpcUaProcess:
             raise
         self.server = server
         server.start_clock(remote.snapshot.time)
-        server.publish(remote.snapshot.values, remote.applied, remote.snapshot.time)
+        await server.publish(remote.snapshot.values, remote.applied, remote.snapshot.time)
         self.remote = remote
+        self._anchor = not remote.lockstep
         remote.subscribe(self._publish)
-        # the address space (tens of thousands of asyncua objects) lives as long as the server: out of the
-        # collector's full passes (this process is the OPC UA server's alone)
-        gc.collect()
-        gc.freeze()
         return self.lines(o), self.endpoints(o)
 
-    def _publish(self, snapshot) -> None:
-        self.server.publish(snapshot.values, self.remote.applied, snapshot.time)
-        self.server.send_due()
+    async def _publish(self, snapshot) -> None:
+        if self._anchor:  # real time: the runner starts once every front end is ready; its first step anchors
+            self._anchor = False  # the clock, so a SourceTimestamp is its step's due time (give or take the link)
+            self.server.start_clock(snapshot.time)
+        await self.server.publish(snapshot.values, self.remote.applied, snapshot.time)
 
     def lines(self, o) -> list[str]:
         server, security = self.server, o["security"]

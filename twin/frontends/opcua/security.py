@@ -107,8 +107,9 @@ class Security:
             pass
         return cert, key
 
-    async def apply(self, server, host: str) -> None:
-        """Endpoints, certificate and identity tokens of an asyncua `Server` (before `start`)."""
+    async def apply(self, server, host: str, on_request=None) -> None:
+        """Endpoints, certificate and identity tokens of an asyncua `Server` (before `start`); `on_request(user,
+        type_id, body)` before every request of a session (`_asyncua_roles.Roles`)."""
         policies = self.policies_for(host)
         unknown = [p for p in policies if p not in POLICIES]
         if unknown or not policies:
@@ -122,7 +123,7 @@ class Security:
         from ._asyncua_roles import Roles
 
         server.set_security_policy([getattr(ua.SecurityPolicyType, POLICIES[p]) for p in policies],
-                                   permission_ruleset=Roles())
+                                   permission_ruleset=Roles(on_request))
         if self.accounts:
             server.set_identity_tokens([ua.UserNameIdentityToken])
         else:
@@ -130,6 +131,5 @@ class Security:
 
 
 def is_reader(user) -> bool:
-    """A session of a read-only account: its asyncua User has the Anonymous role (`_asyncua_roles.Accounts`;
-    asyncua is not imported here, so its role is compared by name)."""
-    return getattr(getattr(user, "role", None), "name", None) == "Anonymous"
+    """A session of a read-only account (`_asyncua_roles.SessionUser.read_only`; asyncua is not imported here)."""
+    return bool(getattr(user, "read_only", False))

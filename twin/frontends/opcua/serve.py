@@ -50,8 +50,9 @@ class OneLineLog(logging.Handler):
                                                                       "(its connection is closed)"}
 
     def __init__(self, sink=None):
-        """`sink(text, level)`: where the lines go (default the `twin.serve` logger of this process)."""
-        super().__init__()
+        """`sink(text, level)`: where the lines go (default the `twin.serve` logger of this process). Warnings and
+        errors only (`sessions` asks asyncua for some of its INFO records, which are not for the log)."""
+        super().__init__(logging.WARNING)
         self.sink = sink
 
     def emit(self, record: logging.LogRecord) -> None:
