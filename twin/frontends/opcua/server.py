@@ -7,10 +7,10 @@ validated writes to the cell, which applies them at the start of the next step:
   `cell_link`) writes every value that changed into the address space (`Server.write_attribute_value`), one
   DataValue per variable, which asyncua queues for every monitored item on it: a subscription sees the value
   of every step, even one that lasts a single step. Its SourceTimestamp is the step's simulated time on the
-  server's clock: the UTC wall time when the server started, less the simulated time then, plus the step's
-  simulated seconds (`start_clock`). In real time at speed 1 that is the step's due time on the wall clock; in
-  lockstep, timestamps advance by exactly one step per step however fast the steps run. ServerTimestamp is the
-  wall clock when the value was published.
+  server's clock: simulated seconds from an anchor, the UTC wall time less the simulated time when the clock
+  was started (`start_clock`: `cell_link` starts it again at the first step in real time, so at speed 1 a
+  timestamp is its step's due time, give or take the link). Timestamps advance by exactly one step per step
+  however fast the steps run. ServerTimestamp is the wall clock when the value was published.
 - A client's write of a signal is taken by asyncua's PreWrite callback (`_pre_write`): outputs are read-only
   (BadNotWritable), a Variant of another type is BadTypeMismatch, a value outside the signal's range (or NaN,
   or a text that is none of an enumeration's choices) BadOutOfRange, a read-only user BadUserAccessDenied, a
