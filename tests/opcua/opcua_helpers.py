@@ -36,10 +36,18 @@ def node(client: Client, ns: int, name: str):
     return client.get_node(ua.NodeId(name, ns))
 
 
+CHUNK = 50  # steps per Sim.Advance call (see `advance`)
+
+
 async def advance(client: Client, ns: int, steps: int) -> int:
-    """Sim.Advance(steps): returns sim.step once the steps are done."""
-    sim = node(client, ns, "Sim")
-    return await sim.call_method(ua.NodeId("Sim.Advance", ns), ua.Variant(steps, ua.VariantType.UInt32))
+    """Sim.Advance(steps), in calls of at most CHUNK steps: returns sim.step once the steps are done. asyncua
+    answers a connection's requests in order, and its client's keep-alive read gives up after 1 s: a call
+    that runs longer on a loaded machine would cost the connection (docs/opcua.md)."""
+    sim, method = node(client, ns, "Sim"), ua.NodeId("Sim.Advance", ns)
+    step = await sim.call_method(method, ua.Variant(min(steps, CHUNK), ua.VariantType.UInt32))
+    for done in range(CHUNK, steps, CHUNK):
+        step = await sim.call_method(method, ua.Variant(min(CHUNK, steps - done), ua.VariantType.UInt32))
+    return step
 
 
 async def write_status(n, value, vtype=None) -> str:
