@@ -10,7 +10,7 @@ judged against issue 18's thresholds (docs/check.md says why each one):
     status     2 (closing) / 1 (opening) within 10 steps of touching, and steady while pressing, `moving` off
     noise      the pressing joint's position spread while pressing <= 0.05 mm (0.001 rad)
     force      the finger's force = its drive's effort (shared over a mimic linkage) within 10 %
-    penetration  closest distance of the nominal shapes >= -0.5 mm
+    penetration  how deep the nominal shapes overlap (into the part) <= 0.5 mm
     push       a centred part pushed < 0.5 mm by the closing grip
     creep      a resting part < 0.1 mm in the hold time (5 s); a held part < 0.2 mm relative to the gripper
     capacity   mu x sum of the normal forces >= 3 x the weight (below 1 x it cannot hold); a lift keeps it within 1 mm
@@ -45,6 +45,8 @@ TRAVEL_SPEED = 0.5  # m/s: to the approach pose (MoveJ)
 SWEEP_SAMPLES = 400  # positions per range in the reach sweep (refined by bisection)
 CLEARANCE = {"m": 0.01, "rad": 0.2}  # a pre-grip position stands this far off the part (or half the free room)
 FAR = 1.0  # m: the reach sweep's query distance
+STEEL = 7900.0  # kg/m^3
+DENSITY_LIMIT = 3 * STEEL  # a finger link denser than this (osmium, the densest metal, is 22600) has a wrong mass
 PICTURE_PITCH = -15.0  # deg: the grip seen from a little above the part, the fingers in front of the gripper
 
 
@@ -72,11 +74,13 @@ class FingerResult:
     contact_lost: int = 0  # steps of the hold in which its contact flag was off
     status: list = field(default_factory=list)  # [[status, steps], ...] from the closing command on
     noise: float | None = None  # position spread while pressing (m or rad)
+    position: float | None = None  # mean position of the pressing joint while pressing (m or rad)
     force: float | None = None  # mean force while pressing (N or N*m)
     force_range: tuple | None = None
     expected_force: float | None = None
     normal_force: float | None = None  # mean sum of the contact normal forces on the part (N)
-    penetration: float | None = None  # closest distance of the nominal shapes while pressing (m; < 0: overlap)
+    penetration: float | None = None  # m, >= 0: the deepest overlap of the nominal shapes while pressing (into the part)
+    closest: float | None = None  # m: their smallest signed distance then (> 0: apart, < 0: overlapping by -closest)
 
 
 @dataclass
@@ -195,36 +199,6 @@ class _Reach:
             self._restore(saved)
         return max(servos, key=lambda n: travel[n])
 
-    def _shape_centre(self, finger: str):
-        """The centre of the finger's collision shapes' bounding box in the world (a revolute finger's link frame,
-        and often its centre of mass, sits on its pivot and hardly moves as it turns; its shapes do)."""
-        boxes = [self.c.getAABB(self.body, link) for link in self.g.finger_links[finger]]
-        return [(min(b[0][i] for b in boxes) + max(b[1][i] for b in boxes)) / 2 for i in range(3)]
-
-    def closing(self, drive: str) -> float:
-        """+1 or -1: the way of `drive` that brings the fingers' shapes together (their spread about their centre
-        shrinks), from a small move of the joint (put back)."""
-        fingers = list(self.g.finger_links)
-
-        def points():
-            pts = [self._shape_centre(f) for f in fingers]
-            if len(pts) == 1:
-                pts.append(self.c.getBasePositionAndOrientation(self.body)[0])
-            return pts
-
-        saved = self._saved()
-        try:
-            pts = points()
-            centre = [sum(p[i] for p in pts) / len(pts) for i in range(3)]
-            base = sum(math.dist(p, centre) for p in pts)
-            inp, q = self.twin.mechanism.input(drive), self.twin.read(drive)
-            delta = (0.001 if inp.unit == "m" else 0.01) * (1 if q + 0.001 <= inp.max else -1)
-            self._set(drive, q + delta)
-            moved = sum(math.dist(p, centre) for p in points()) - base
-        finally:
-            self._restore(saved)
-        return (-1.0 if moved > 0 else 1.0) * (1 if delta > 0 else -1)
-
     def lift_axis(self, closing: set, gravity) -> tuple[str, float] | None:
         """A prismatic input that moves every finger alike, against gravity (a gantry's lift): (its name, +1 or -1,
         the direction that lifts). None if there is none."""
@@ -254,12 +228,19 @@ class _Reach:
             self._restore(saved)
         return None
 
-    def sweep(self, drive: str, fingers: list[str], uid: int, placed: Pose) -> dict[str, dict]:
+    def sweep(self, drive: str, fingers: list[str], uid: int, placed: Pose, here: float | None = None
+              ) -> dict[str, dict]:
         """For each finger the drive moves: where it touches the part closing from the open end (`outside`),
         where it touches the bore's wall opening from inside (`inside`, with the free room `bore`), and its
-        distance at the closed end; positions of the drive's joint."""
+        distance at the closed end; positions of the drive's joint.
+
+        With `here` (no robot to bring the fingers anywhere else) the drive's joint can only move from where it
+        stands: `outside` is then where the finger first meets the part closing from `here`, `inside` where it
+        first meets it opening from `here` (a finger standing in a bore), each None when that way is free to the
+        range's end, `bore` the free room opening, `min_gap` the closest it comes closing; `stuck` says it
+        touches the part where it stands."""
         inp = self.twin.mechanism.input(drive)
-        closing = self.closing(drive)
+        closing = self.g.closing[drive]  # the core's rule: the way the fingers' shapes come together
         open_end, closed_end = (inp.min, inp.max) if closing > 0 else (inp.max, inp.min)
         qs = [open_end + (closed_end - open_end) * k / SWEEP_SAMPLES for k in range(SWEEP_SAMPLES + 1)]
         saved = self._saved()
@@ -280,11 +261,30 @@ class _Reach:
                         b = m
                 return (a + b) / 2
 
+            def first_touch(f, path):
+                """Where the finger first touches the part along `path` [(q, d), ...] (its first entry free)."""
+                k = next((k for k, (_, d) in enumerate(path) if d <= 0), None)
+                return None if k is None else refine(f, path[k - 1][0], path[k][0])
+
+            at_here = dists(here) if here is not None else None
             result = {}
             for f in fingers:
                 d = [s[f] for s in samples]
                 if any(v is None for v in d):
                     result[f] = {"measured": False}
+                    continue
+                ends = {"open_gap": d[0], "closed_gap": d[-1], "open_end": open_end, "closed_end": closed_end}
+                if here is not None:
+                    # the range seen from where the finger stands: closing on one side, opening on the other
+                    side = [(q - here) * (1 if closed_end > open_end else -1) for q in qs]
+                    path_close = [(here, at_here[f])] + [(q, v) for q, v, x in zip(qs, d, side) if x > 0]
+                    path_open = [(here, at_here[f])] + [(q, v) for q, v, x in zip(qs, d, side) if x < 0][::-1]
+                    stuck = at_here[f] <= 0
+                    inside = None if stuck else first_touch(f, path_open)
+                    result[f] = {"measured": True, "stuck": stuck, "here": here, "here_gap": at_here[f],
+                                 "outside": None if stuck else first_touch(f, path_close), "inside": inside,
+                                 "bore": abs(here - (inside if inside is not None else open_end)),
+                                 "min_gap": min(v for _, v in path_close), **ends}
                     continue
                 out = inside = None
                 bore = 0.0
@@ -298,11 +298,30 @@ class _Reach:
                         end = next((k for k in range(back, len(d)) if d[k] <= 0), len(d) - 1)
                         bore = abs(qs[end] - inside)
                 result[f] = {"measured": True, "outside": out, "inside": inside, "bore": bore,
-                             "open_gap": d[0], "closed_gap": d[-1], "min_gap": min(d),
-                             "open_end": open_end, "closed_end": closed_end}
+                             "min_gap": min(d), **ends}
             return result
         finally:
             self._restore(saved)
+
+
+def _volume(c, body: int, link: int) -> float:
+    """m^3: the summed volume of a link's collision shapes (a mesh: its link's bounding box, at least as much)."""
+    import pybullet
+
+    total = 0.0
+    for shape in c.getCollisionShapeData(body, link):
+        kind, dims = shape[2], shape[3]
+        if kind == pybullet.GEOM_BOX:
+            total += dims[0] * dims[1] * dims[2]
+        elif kind == pybullet.GEOM_SPHERE:
+            total += 4 / 3 * math.pi * dims[0] ** 3
+        elif kind in (pybullet.GEOM_CYLINDER, pybullet.GEOM_CAPSULE):
+            r, length = dims[1], dims[0]
+            total += math.pi * r * r * length + (4 / 3 * math.pi * r ** 3 if kind == pybullet.GEOM_CAPSULE else 0.0)
+        else:
+            lo, hi = c.getAABB(body, link)
+            return math.prod(h - l for l, h in zip(lo, hi))  # covers every shape of the link
+    return total
 
 
 def _rle(seq: list[int]) -> list[list[int]]:
@@ -325,6 +344,16 @@ def _fmt_len(v: float | None, unit: str = "m", digits: int = 3) -> str:
     if v is None:
         return "-"
     return f"{v * 1000:.{digits}f} mm" if unit == "m" else f"{v * 1000:.{digits}f} mrad"
+
+
+def _fmt_depth(r: FingerResult, short: bool = False) -> str:
+    """A finger's penetration as a user reads it: how far into the part, or how far short of it."""
+    if r.closest is None:
+        return "-"
+    if r.closest > 0:
+        return f"0 ({_fmt_len(r.closest)} apart)" if short else \
+            f"none: the shapes {_fmt_len(r.closest)} apart at the closest"
+    return _fmt_len(r.penetration) + ("" if short else " into the part at the deepest")
 
 
 def _fmt_pos(v: float | None, unit: str) -> str:
@@ -426,8 +455,9 @@ class Doctor:
         return self.g.joint[drive]
 
     def linkage_share(self, finger: str, drive: str, fingers: list[str]) -> float:
-        """The share of the drive's effort that reaches this finger: on a mimic linkage the effort E balances
-        sum(m_k Q_k) over the coupled fingers (virtual work), so each presses with E / sum |m_k|."""
+        """The share of the drive's effort that reaches this finger (docs/check.md, `force`): on a mimic linkage the
+        effort E balances sum(|m_k| Q_k) over the coupled fingers (virtual work, m_k = 1 for the master), and a free
+        part between them takes equal forces Q_k, so each presses with E / sum |m_k|."""
         mult = {}
         for f in fingers:
             own = self.twin.world.joint_index[next(x.joint for x in self.mech.fingers if x.name == f)]
@@ -438,7 +468,30 @@ class Doctor:
                     mult[f] = abs(mul)
         if finger not in mult:
             return 1.0
-        return mult[finger] / sum(mult.values())
+        return 1.0 / sum(mult.values())  # each coupled finger alike, whatever its own multiplier
+
+    def carried(self, finger: str) -> list[str]:
+        """The other fingers whose links hang from this finger's links: it is a carriage (a lift, a slide), not a
+        finger, when it carries all of them."""
+        mine = set(self.g.finger_links[finger])
+        out = []
+        for f, links in self.g.finger_links.items():
+            j = links[0] if f != finger else -1
+            while j >= 0 and j not in mine:
+                j = self.c.getJointInfo(self.body, j)[16]  # the parent link
+            if j >= 0:
+                out.append(f)
+        return out
+
+    def carriage_hint(self, finger: str) -> str:
+        """How to fix a reach failure of a carriage taken for a finger (detection counts any moving link with
+        collision shapes): name the fingers in the station."""
+        carried = self.carried(finger)
+        if not carried:
+            return ""
+        names = ", ".join(f'"{f}"' for f in self.fingers if f != finger and f in carried)
+        return (f"; {finger} carries {', '.join(carried)}: if it is a carriage, not a finger, name the fingers in "
+                f"station.toml: [gripper] fingers = [{names}]")
 
     def wait_in_position(self, drives, limit_s: float) -> None:
         for _ in range(self.steps(limit_s)):
@@ -455,18 +508,14 @@ class Doctor:
         if not self.twin.read("Active"):
             self.twin.write("Active", True)  # a gripper that is not always active follows its setpoints once told to
         self.rest()
+        self.densities()
         drive_of = {f: self.reach.closing_drive(f) for f in self.fingers}
-        for d in sorted({d for d in drive_of.values() if d is not None}, key=list(self.g.joint).index):
-            mine, twins = self.reach.closing(d), self.g.closing[d]
-            if mine != twins:
-                sign = {1.0: "increasing", -1.0: "decreasing"}
-                self.check(FAIL, "station", d, "closing", f"its fingers close with {sign[mine]} {d}, the twin takes "
-                           f"{sign[twins]} {d} for closing (its status 2 and 1 are swapped)")
         first = next((d for d in drive_of.values() if d is not None), None)
         if first is not None:  # the link the (first) closing drive's joint sits on
             self.carrier = self.c.getJointInfo(self.body, self.g.joint[first])[16]
         if self.twin.robot is None:
             self.lift_axis = self.reach.lift_axis(set(drive_of.values()), self.twin.station.gravity)
+        self.home = {d: self.twin.read(d) for d in dict.fromkeys(d for d in drive_of.values() if d is not None)}
         for body in st.targets:
             for mode in ("outside", "inside"):
                 plans = self.plan(body.name, drive_of)  # where the part is now (an earlier grip may have moved it)
@@ -479,6 +528,25 @@ class Doctor:
                     self.check(FAIL, f"{body.name} {mode}", "robot", "motion", str(exc))
                     return self.report
         return self.report
+
+    def densities(self) -> None:
+        """A WARN per finger link whose mass does not fit its size: denser than DENSITY_LIMIT over the volume of
+        its collision shapes (a mesh counted by its link's bounding box, so its density is never overstated).
+        A typo (2000 for 2 kg) tunes the drives for a mass the finger does not have."""
+        c, body = self.c, self.body
+        names = self.twin.world.link_name
+        for f in self.fingers:
+            for link in self.g.finger_links[f]:
+                mass = c.getDynamicsInfo(body, link)[0]
+                volume = _volume(c, body, link)
+                if mass <= 0 or not volume:
+                    continue
+                density = mass / volume
+                if density > DENSITY_LIMIT:
+                    self.check(WARN, "station", names.get(link, f), "mass",
+                               f"{mass:.4g} kg in {volume * 1e6:.4g} cm^3 of collision shapes is {density:.3g} "
+                               f"kg/m^3, {density / STEEL:.0f}x steel's {STEEL:g}: a typo in the URDF's <mass>? (the "
+                               "drives are tuned for it)")
 
     def rest(self) -> None:
         """Every target left alone for the hold time: how far does it creep on its support?"""
@@ -494,7 +562,8 @@ class Doctor:
                        f"{_fmt_len(creep)} in {self.hold:g} s on its support (< {_fmt_len(REST_CREEP, digits=1)})")
 
     def plan(self, name: str, drive_of: dict) -> dict:
-        """The reach sweep of every closing drive, with the gripper at the grip pose."""
+        """The reach sweep of every closing drive, with the gripper at the grip pose; without a robot, from where
+        each drive's joint stands (nothing can bring the fingers to the part's other side of their range)."""
         placed_rel = self.grip_pose(name).inverse() * self.part_pose(name)  # the part as the TCP will see it
         placed = self.tcp() * placed_rel  # ...placed in the world relative to where the gripper is now
         uid = self.twin.world.body_ids[name]
@@ -504,7 +573,8 @@ class Doctor:
                 by_drive.setdefault(d, []).append(f)
         plans = {}
         for d, fingers in by_drive.items():
-            plans.update(self.reach.sweep(d, fingers, uid, placed))
+            here = None if self.twin.robot is not None else self.c.getJointState(self.body, self.g.joint[d])[0]
+            plans.update(self.reach.sweep(d, fingers, uid, placed, here))
         return plans
 
     def grip(self, name: str, mode: str, plans: dict, drive_of: dict, result: GripResult) -> None:
@@ -521,56 +591,68 @@ class Doctor:
             result.skipped = "no nominal shape for " + ", ".join(unmeasured)
             self.check(WARN, where, ", ".join(unmeasured), "reach", "the finger's shapes cannot be measured: not checked")
             return
+        robot = tw.robot is not None
+        if mode == "inside" and shape != "ring":
+            result.skipped = f"a {shape} has no bore"
+            return
+        stuck = [f for f in fingers if plans[f].get("stuck")]
+        if stuck:  # without a robot: a finger standing on (or in) the part can start no grip
+            result.skipped = "the fingers touch it where they stand"
+            for f in stuck:
+                self.check(WARN, where, f, "reach", f"touches {name} where it stands (gap "
+                           f"{_fmt_len(plans[f]['here_gap'])}): start it free of the part (the station's `initial`)")
+            return
         if mode == "inside":
-            if shape != "ring":
-                result.skipped = f"a {shape} has no bore"
-                return
             missing = [f for f in fingers if plans[f]["inside"] is None]
             if missing:
-                result.skipped = "the fingers do not fit into the bore"
-                self.check(INFO, where, ", ".join(missing), "reach", "cannot open against the bore from inside: "
-                           "no inside grip checked")
+                result.skipped = ("the fingers do not fit into the bore" if robot else
+                                  "the fingers stand outside the bore, and there is no robot to bring them in")
+                self.check(INFO, where, ", ".join(missing), "reach",
+                           ("cannot open against the bore from inside" if robot else
+                            "opening from where it stands meets no bore") + ": no inside grip checked")
                 return
         else:
             missing = [f for f in fingers if plans[f]["outside"] is None]
-            # a ring the fingers can only hold from inside: no outside grip is no failure
+            # a ring the fingers can only hold from inside (or, without a robot, whose bore they stand in): no
+            # outside grip is no failure
             bore_only = shape == "ring" and all(plans[f]["inside"] is not None for f in fingers)
             if missing:
                 for f in missing:
                     p = plans[f]
-                    why = (f"touches it already when fully open (gap {_fmt_len(p['open_gap'])})" if p["open_gap"] <= 0
-                           else f"closest {_fmt_len(p['min_gap'])} away over its whole travel")
+                    if not robot and bore_only:
+                        self.check(INFO, where, f, "reach", f"stands in the bore of {name}: closing from there meets "
+                                   "nothing (its inside grip is checked)")
+                        continue
+                    if not robot:
+                        why = (f"closing from where it stands ({_fmt_pos(p['here'], self.unit[drive_of[f]])}) it comes "
+                               f"no closer than {_fmt_len(p['min_gap'])}")
+                    elif p["open_gap"] <= 0:
+                        why = f"touches it already when fully open (gap {_fmt_len(p['open_gap'])})"
+                    else:
+                        why = f"closest {_fmt_len(p['min_gap'])} away over its whole travel"
                     self.check(INFO if bore_only else FAIL, where, f, "reach", f"cannot reach {name}: {why}"
-                               + (" (it grips the bore)" if bore_only else ""))
+                               + (" (it grips the bore)" if bore_only else self.carriage_hint(f)))
                 result.skipped = "the fingers grip it from inside only" if bore_only else "out of reach"
                 return
         drives = sorted({drive_of[f] for f in fingers}, key=list(self.g.joint).index)
         # where each drive starts (free of the part) and where it is told to go (the range's end past the part)
         start, goal = {}, {}
-        robot = tw.robot is not None
         for d in drives:
             mine = [f for f in fingers if drive_of[f] == d]
             p = [plans[f] for f in mine]
             unit = self.unit[d]
+            goal[d] = p[0]["closed_end"] if mode == "outside" else p[0]["open_end"]
+            if not robot:  # where it stands: free of the part, which lies ahead of it (the sweep from there says)
+                start[d] = self.home[d]
+                continue
             if mode == "outside":
                 touch = p[0]["open_end"] + min((x["outside"] - x["open_end"] for x in p), key=abs)
                 room = touch - p[0]["open_end"]
-                goal[d] = p[0]["closed_end"]
             else:
                 touch = p[0]["open_end"] + max((x["inside"] - x["open_end"] for x in p), key=abs)
                 room = -min(x["bore"] for x in p) * (1 if p[0]["closed_end"] > p[0]["open_end"] else -1)
-                goal[d] = p[0]["open_end"]
             # room: signed, from the touching position into the free space the finger starts from
-            step_back = math.copysign(min(CLEARANCE[unit], abs(room) / 2), -room)
-            here = tw.read(d)
-            free = (here - touch) * math.copysign(1, -room) > 0 and abs(here - touch) <= abs(room)
-            start[d] = here if free and not robot else touch + step_back
-        if not robot:
-            blocked = [d for d in drives if start[d] != tw.read(d)]
-            if blocked and mode == "inside":
-                result.skipped = "the fingers start outside the bore, and there is no robot to bring them in"
-                self.check(INFO, where, ", ".join(blocked), "reach", result.skipped + ": no inside grip checked")
-                return
+            start[d] = touch + math.copysign(min(CLEARANCE[unit], abs(room) / 2), -room)
         # bring the open gripper to the part
         if robot:
             back = self.approach_distance(name)
@@ -594,6 +676,10 @@ class Doctor:
         self.wait_in_position(drives, 10.0)
         if robot:
             tw.run_motion("MoveL", self.backed_off(tw.tcp_pose(), back), APPROACH_SPEED * 2, name="away")
+        else:  # back where the station put them: the next grip is planned from there
+            for d, q in self.home.items():
+                tw.write(d, q)
+            self.wait_in_position(list(self.home), 10.0)
         tw.step(self.steps(0.5))
 
     def close_and_hold(self, name, mode, where, drives, drive_of, plans, goal, result) -> None:
@@ -685,10 +771,12 @@ class Doctor:
             r = res[f]
             r.status = _rle(status[f])
             r.noise = max(pos[f]) - min(pos[f])
+            r.position = sum(pos[f]) / n
             r.force = sum(force[f]) / n
             r.force_range = (min(force[f]), max(force[f]))
             r.normal_force = sum(normal[f]) / n
-            r.penetration = pen[f]
+            r.closest = pen[f]
+            r.penetration = None if pen[f] is None else max(0.0, -pen[f])
             d = drive_of[f]
             r.expected_force = g.drives[d].effort * self.linkage_share(f, d, fingers)
         result.weight = self.weight(name)
@@ -726,10 +814,9 @@ class Doctor:
             if r.penetration is None:
                 self.check(WARN, where, f, "penetration", "not measured (the finger's shapes)")
             else:
-                ok = r.penetration >= -PENETRATION
-                self.check(PASS if ok else FAIL, where, f, "penetration",
-                           f"closest distance {_fmt_len(r.penetration)} while pressing (>= "
-                           f"{_fmt_len(-PENETRATION, digits=1)})")
+                ok = r.penetration <= PENETRATION
+                self.check(PASS if ok else FAIL, where, f, "penetration", f"{_fmt_depth(r)} while pressing (<= "
+                           f"{_fmt_len(PENETRATION, digits=1)})")
         for f, r in res.items():
             if r.onset_step is not None and r.contact_lost:
                 self.check(FAIL, where, f, "contact", f"contact flag off in {r.contact_lost} of the hold's "
@@ -835,7 +922,7 @@ def format_report(report: Report) -> str:
                 force = "-" if r.force is None else f"{r.force:.4g} / {r.expected_force:.4g} {u}"
                 rows.append((r.finger, r.drive, _fmt_pos(r.contact_geometry, r.unit), onset,
                              _runs(r.status, 4), _fmt_len(r.noise, r.unit),
-                             _fmt_len(r.penetration), force,
+                             _fmt_depth(r, short=True), force,
                              "-" if r.normal_force is None else f"{r.normal_force:.4g} N"))
             widths = [max(len(row[i]) for row in rows) for i in range(len(rows[0]))]
             for row in rows:
