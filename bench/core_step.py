@@ -1,6 +1,6 @@
 """Core benchmark: simulation steps per second, and how the grip check's cost grows with the target group.
 
-    python -m bench core [--steps N]
+    python -m bench core [--steps N] [--against REV [--rounds N]]
 
 Table 1: for every shipped station, the twin's step against the raw physics of the very same world (its
 `substeps` calls of pybullet's stepSimulation, nothing else), timed side by side in one run, alternating in
@@ -9,6 +9,10 @@ and how many times real time each runs headless. The cell rests as loaded, so on
 bodies are frozen (twin/core/stasis.py) for both columns. Then the ring rig in motion: a pick-and-place through
 the simulation API, simulated against wall seconds, with the physics timed inside the twin's own step (what the twin
 adds on top of the physics it runs, in motion).
+With `--against REV` (a git revision of this repository, e.g. the commit before a change) only the ring rig's figures
+are measured, for REV's twin and stations and for this tree's, alternately in separate processes for `--rounds`
+rounds, and printed side by side: before and after in one run, a busy machine slowing both alike. The in-motion
+line's x real time is also given in CPU time (the process's own thread), which a shared machine disturbs less.
 Table 2: the four-finger gripper gripping its puck among N extra free cylinders of the target group,
 scattered on the floor. Per step: the whole step, and the grip check (contacts of every finger with the
 targets) done two ways side by side: ours (a broad-phase AABB query, then exact closest points only
@@ -17,7 +21,11 @@ against targets near a finger) and the naive one (closest points against every t
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -46,10 +54,10 @@ def twin_vs_physics(station: Path, steps: int, rounds: int = 5) -> dict[str, flo
         return {"twin": twin_med, "physics": raw_med, "dt": twin.dt}
 
 
-def ring_rig_in_motion() -> tuple[float, float, float]:
-    """Simulated and wall seconds of a pick-and-place on the ring rig through the simulation API (grip, lift,
+def ring_rig_in_motion(stations: Path = STATIONS) -> tuple[float, float, float, float, float]:
+    """Simulated, wall and CPU seconds of a pick-and-place on the ring rig through the simulation API (grip, lift,
     carry, set down, release, with a second's pause at either end): the physics of a held 66 kg ring, moving; and the
-    wall seconds of that physics, timed inside the twin's step."""
+    wall and CPU seconds of that physics, timed inside the twin's step."""
     from twin.core import Twin
 
     def go(twin, instr, target, speed):
@@ -57,17 +65,18 @@ def ring_rig_in_motion() -> tuple[float, float, float]:
         while twin.robot_busy:
             twin.step()
 
-    with Twin.from_station(STATIONS / "ring_rig") as twin:
-        physics = [0.0]
+    with Twin.from_station(stations / "ring_rig") as twin:
+        physics = [0.0, 0.0]
         substep = twin.world.substep_physics
 
         def timed_substep() -> None:  # the physics the twin runs, timed inside its own step
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.thread_time()
             substep()
             physics[0] += time.perf_counter() - t
+            physics[1] += time.thread_time() - c
 
         twin.world.substep_physics = timed_substep
-        t0 = time.perf_counter()
+        t0, cpu0 = time.perf_counter(), time.thread_time()
         twin.step(round(1.0 / twin.dt))
         for name in ("L2", "L3", "L4"):
             twin.write(name, 0.319)
@@ -80,7 +89,56 @@ def ring_rig_in_motion() -> tuple[float, float, float]:
         twin.step(round(1.0 / twin.dt))
         go(twin, "MoveL", "app_left", 1.0)
         twin.step(round(1.0 / twin.dt))
-        return twin.time, time.perf_counter() - t0, physics[0]
+        return twin.time, time.perf_counter() - t0, time.thread_time() - cpu0, physics[0], physics[1]
+
+
+def ring_rig_figures(stations: Path, steps: int) -> dict[str, float]:
+    """The ring rig's figures of this benchmark (at rest: ring_rig and ring_rig_plc; in motion), for `--against`."""
+    out = {}
+    for name in ("ring_rig", "ring_rig_plc"):
+        r = twin_vs_physics(stations / name, steps)
+        out[name] = r["twin"] / r["physics"]
+        out[name + " twin x rt"] = r["dt"] / r["twin"] * 1e6
+    sim, wall, cpu, physics, physics_cpu = ring_rig_in_motion(stations)
+    out.update({"motion x rt": sim / wall, "motion x rt (cpu)": sim / cpu, "motion adds %": 100 * (wall - physics) / physics,
+                "motion adds % (cpu)": 100 * (cpu - physics_cpu) / physics_cpu})
+    return out
+
+
+def against(rev: str, rounds: int, steps: int) -> int:
+    """REV's ring rig figures beside this tree's, measured alternately in fresh processes (module docstring)."""
+    root = Path(__file__).resolve().parent.parent
+    rows = ("ring_rig", "ring_rig twin x rt", "ring_rig_plc", "ring_rig_plc twin x rt", "motion x rt",
+            "motion x rt (cpu)", "motion adds %", "motion adds % (cpu)")
+    with tempfile.TemporaryDirectory(prefix="bench-core-") as tmp:
+        archive = subprocess.run(["git", "-C", str(root), "archive", rev], capture_output=True, check=False)
+        if archive.returncode:
+            print(f"python -m bench core: --against {rev}: {archive.stderr.decode().strip()}", file=sys.stderr)
+            return 2
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
+        trees = {rev: Path(tmp), "this tree": root}
+        figures: dict[str, list[dict]] = {label: [] for label in trees}
+        code = ("import json, runpy, sys; m = runpy.run_path(sys.argv[1]); "
+                "print(json.dumps(m['ring_rig_figures'](m['Path'](sys.argv[2]), int(sys.argv[3]))))")
+        for _ in range(rounds):
+            for label, tree in trees.items():  # this file's measurements, the tree's twin and stations
+                env = {**os.environ, "PYTHONPATH": str(tree)}
+                done = subprocess.run([sys.executable, "-c", code, __file__, str(tree / "stations"), str(steps)],
+                                      cwd=tree, env=env, capture_output=True, text=True, check=True)
+                figures[label].append(json.loads(done.stdout.strip().splitlines()[-1]))
+    print(f"The ring rig, {rev} vs this tree, alternately in fresh processes, {rounds} rounds: median [min - max]")
+    print(f"{'':<34}" + "".join(f"{label:>24}" for label in trees))
+    names = {"ring_rig": "at rest ring_rig twin/physics", "ring_rig_plc": "at rest ring_rig_plc twin/physics",
+             "ring_rig twin x rt": "at rest ring_rig twin x rt", "ring_rig_plc twin x rt": "at rest ring_rig_plc twin x rt",
+             "motion x rt": "in motion x real time (wall)", "motion x rt (cpu)": "in motion x real time (CPU)",
+             "motion adds %": "in motion, the twin adds (%)", "motion adds % (cpu)": "in motion, the twin adds (% CPU)"}
+    for row in rows:
+        cells = []
+        for label in trees:
+            values = [f[row] for f in figures[label]]
+            cells.append(f"{statistics.median(values):.2f} [{min(values):.2f}-{max(values):.2f}]")
+        print(f"{names[row]:<34}" + "".join(f"{c:>24}" for c in cells))
+    return 0
 
 
 def crowded_station(folder: Path, extra: int) -> Path:
@@ -132,7 +190,11 @@ def grip_check_costs(extra: int, steps: int) -> dict[str, float]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench core")
     parser.add_argument("--steps", type=int, default=300)
+    parser.add_argument("--against", metavar="REV", help="a git revision: its ring rig figures beside this tree's")
+    parser.add_argument("--rounds", type=int, default=3, help="with --against: rounds of alternation (default 3)")
     args = parser.parse_args(argv)
+    if args.against:
+        return against(args.against, args.rounds, args.steps)
     print("The twin's step vs the raw physics of the same world (stepSimulation x substeps), headless, per step")
     print(f"{'station':<16}{'physics us':>12}{'twin us':>10}{'added us':>10}{'twin/physics':>14}{'physics x rt':>14}"
           f"{'twin x rt':>11}")
@@ -142,10 +204,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name:<16}{r['physics']:>12.0f}{r['twin']:>10.0f}{r['twin'] - r['physics']:>10.0f}"
               f"{r['twin'] / r['physics']:>14.2f}{rt / r['physics']:>14.1f}{rt / r['twin']:>11.1f}")
     print("(the cell at rest, as loaded: after 0.3 s at rest its loose bodies are frozen, twin/core/stasis.py)")
-    sim, wall, physics = ring_rig_in_motion()
+    sim, wall, cpu, physics, physics_cpu = ring_rig_in_motion()
     print(f"ring_rig in motion (pick and place, simulation API): {sim:.1f} s simulated in {wall:.2f} s wall, "
-          f"{sim / wall:.1f}x real time; physics {physics:.2f} s of it (timed inside the twin's step), "
-          f"the twin adds {100 * (wall - physics) / physics:.0f} %")
+          f"{sim / wall:.1f}x real time ({sim / cpu:.1f}x in CPU time); physics {physics:.2f} s of it (timed inside "
+          f"the twin's step), the twin adds {100 * (wall - physics) / physics:.0f} % "
+          f"({100 * (cpu - physics_cpu) / physics_cpu:.0f} % in CPU time)")
     print()
     print("Grip check cost per step vs size of the target group (four_finger holding its puck)")
     print(f"{'targets':>8}{'step us':>10}{'check us (ours)':>17}{'check us (naive)':>18}{'naive/ours':>12}")
