@@ -296,6 +296,10 @@ class PathClock:
     def tau(self, t: float) -> float:
         return self._phase(t)[0]
 
+    def at(self, t: float) -> tuple[float, float]:
+        """(tau, rate) at t, in one go (the robot asks at every physics substep)."""
+        return self._phase(t)
+
     def rate(self, t: float) -> float:
         return self._phase(t)[1]
 

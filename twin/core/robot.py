@@ -62,6 +62,7 @@ class Robot:
         self._settled = True
         self._held = None
         self._motors = client.setJointMotorControlArray  # bound once: called at every physics substep
+        self._gains = ([position_gain] * len(self.joints), [velocity_gain] * len(self.joints))
         self._joint_states = client.getJointStates
         self._hold = self.q
         self._hold_for: Trajectory | None = None  # the last motion whose end self._hold is
@@ -319,7 +320,7 @@ class Robot:
             return
         if self._clock is None:
             self._clock = PathClock(t)
-        tau, rate = self._clock.tau(t + self.dt), self._clock.rate(t + self.dt)
+        tau, rate = self._clock.at(t + self.dt)
         queue = self._queue
         if tau >= queue.end:
             if self._hold_for is not traj:
@@ -338,11 +339,10 @@ class Robot:
             self._held = q
 
     def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
-        n = len(self.joints)
         self._held = None
         self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=_floats(q),
-                     targetVelocities=_floats(qd), forces=self.forces, positionGains=[self.position_gain] * n,
-                     velocityGains=[self.velocity_gain] * n)
+                     targetVelocities=_floats(qd), forces=self.forces, positionGains=self._gains[0],
+                     velocityGains=self._gains[1])
 
 
 def _floats(values) -> list[float]:
