@@ -95,7 +95,9 @@ def test_a_finger_that_loses_force_does_not_squeeze(bench):
             twin.step(150)
         _, full = healthy.drive_limits("L3")
         assert healthy.read("L3.force") == pytest.approx(full, rel=0.05)
-        assert bench.read("L3.force") <= 20.0 + 1e-6  # signals: its force stays at the lost drive's
+        # signals: its force stays at the lost drive's (pushed back by the ring, it balances it with its motor's 20 N:
+        # the contact force reads that within the solver's 0.1 %, not the 1500 N the other drives press with)
+        assert bench.read("L3.force") <= 20.0 * 1.005
         assert bench.read("L3.force") == pytest.approx(20.0, rel=0.1)
         assert bench.drive_limits("L3")[1] == 20.0  # physics: the motor pushes with 20 N at most
 

@@ -1,13 +1,17 @@
 """The gripper's behaviour, evaluated at every physics substep and after every simulation step.
 
 The drive model (docs/station-format.md, "Drives"). Every input is a servo drive:
-- its *command* moves towards the setpoint at the velocity limit (a ramp; while its finger presses on a part, at
-  least fast enough to reach full force within the force rise time, 50 ms unless the station says), and runs ahead of the joint by no more
+- its *command* moves towards the setpoint at the velocity limit (a ramp; while its finger presses on a part that
+  holds it, at least fast enough to reach full force within the force rise time, 50 ms unless the station says), and
+  runs ahead of the joint by no more
   than the error at which the drive reaches its force limit, so a new setpoint acts at once;
 - a position loop of stiffness K and damping D asks for |K e - D v| (+ a small holding force), e = command - actual,
   v the joint's speed, limited by the effort; within that force pybullet's implicit velocity motor drives the joint
-  to the command in one substep (stable for any finger mass); a drive held back at its force limit asks for far more
-  speed (the solver builds a motor's force only as fast as the speed it asks for);
+  to the command in one substep (stable for any finger mass), never faster than the velocity limit while the joint
+  runs (at least half that speed over the last substep: a part that gives way is pushed along at the drive's speed,
+  as a real servo's speed loop does, not kicked ahead by the force the drive has built); a joint held back (by a
+  part, a stop) asks for more speed, far more at its force limit (the solver builds a motor's force only as fast as
+  the speed it asks for);
 - a drive stalled on a part (97.5 % of its full-force error, exactly, short of its goal, its finger pressing on a target) keeps
   its command where it stands until its force falls by a tenth or the goal changes: the finger holds its place, and
   the rest of its effort resists a push, so two fingers squeezing a part cannot walk it sideways.
@@ -72,6 +76,8 @@ FORCE_RISE_TIME = 0.05  # s: a drive whose finger presses on a part runs its com
 # steps after touching); 50 ms (4 steps) holds every test gripper. The station's `[gripper] force_rise_time` overrides it
 FOLLOW_FRACTION = 0.965  # ... once the error has fallen below this share (both springs of a squeezed pair hold it)
 RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
+HELD_SHARE = 0.5  # a joint that moved less than this share of its velocity limit the drive's way (over the last
+# substep) is held: only then does its command run on to build force, and may it ask for more than its limit's speed
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
 GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's drive effort
@@ -227,6 +233,8 @@ class Gripper:
         self._states = None
         self._step_positions: list[float] | None = None  # the joints' positions at the end of the last step
         self._step_ticks = 0  # physics substeps since the last sense
+        self._speeds = [0.0] * len(self.names)  # each joint's speed over the last substep(s) measured, from positions
+        self._ticks = 0  # physics substeps since the joints were last read
         self._sent: tuple | None = None
         self._per_input = [(name, self.unit[name], MOVING_SPEED[self.unit[name]]) for name in self.names]
         self._joint_axis = {f: client.getJointInfo(body, j)[13] for f, j in self.finger_joint.items()}
@@ -458,6 +466,7 @@ class Gripper:
         rest of the step: nothing changes there but cost. The joints' states are those `measure` read after the
         substep before (nothing moves the joints in between)."""
         self._step_ticks += 1
+        self._ticks += 1
         if substep and self._quiet:
             return
         if not self.active and self._hold is None:
@@ -473,11 +482,13 @@ class Gripper:
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
         axes, presses, series = self.state.axes, self._presses, self._series  # as the last step left them
-        for (name, _, moving), (actual, joint_speed, _, _) in zip(self._per_input, states):
+        for (name, _, moving), (actual, joint_speed, _, _), moved in zip(self._per_input, states, self._speeds):
             d = drives[name]
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
+            # held: the joint moved slower than HELD_SHARE of its velocity limit the way its goal lies (last substep)
+            held = (moved if g > actual else -moved) < HELD_SHARE * d.velocity
             if name in turned:
                 turned.discard(name)
                 if (g - actual) * (before - actual) < 0.0:
@@ -494,8 +505,10 @@ class Gripper:
             else:
                 way = None
                 rate = d.velocity
-                if (before - actual) * (g - actual) > 0.0 and pressing:
-                    rate = max(rate, full / self.rise_time)  # pressing on a part: full force within 50 ms
+                if (before - actual) * (g - actual) > 0.0 and pressing and held:
+                    # pressing on a part that holds the finger: full force within the rise time (a part that gives
+                    # way is pushed at the velocity limit, as a real servo's speed loop does, not run over by the command)
+                    rate = max(rate, full / self.rise_time)
                 target = _towards(before, g, rate * h)
             # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
             target = min(max(target, actual - full), actual + full)
@@ -520,6 +533,10 @@ class Gripper:
                 # at its force limit and held (or pushed) back: pybullet's solver builds a motor's force only as fast
                 # as the speed it asks for, so a held drive asks for far more than it can have: it presses at its limit
                 speed = max(abs(speed), PUSH_SPEEDUP * d.velocity) * (1.0 if error > 0.0 else -1.0)
+            elif abs(speed) > d.velocity and moved * error >= HELD_SHARE * d.velocity * abs(error):
+                # running free (a part that gives way, a finger catching up): never faster than the velocity limit;
+                # a held joint asks for more (the solver builds the force against the part from that speed)
+                speed = d.velocity if speed > 0.0 else -d.velocity
             velocities.append(speed)
             if d.stiffness > d.limit:  # stiffer than the step resolves (a station's choice): rigid up to its effort
                 forces.append(d.effort)
@@ -556,7 +573,13 @@ class Gripper:
         if self._quiet and not last:
             return
         self._n += 1
+        before = self._states
         states = self._states = self._joint_states(self.body, self._joint_ids)
+        if before is not None:  # how fast each joint ran, from its positions (pybullet's joint velocity reads the
+            # motor's target where a contact holds the joint back): whether a part holds it (`drive`)
+            elapsed = self._ticks * self.h
+            self._speeds = [(s[0] - b[0]) / elapsed for s, b in zip(states, before)]
+        self._ticks = 0
         self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
         sums, keys = self._force_sum, self._link_keys
         self._joint_frames.clear()
