@@ -7,16 +7,22 @@ fed the published snapshots and handing its writes back through this adapter; it
 simulation's interpreter, its GIL or its collector, so it can neither make a step late nor change a
 setting of the simulation's process. `twin.runtime.pacing` is the only module that knows the wall clock.
 
-    twin serve (SCHED_RR where allowed)          its own processes (spawned, ordinary scheduling)
-    +------------------------------------+      +----------------------------------------------+
-    | one asyncio loop (+ the log's and  | unix | OPC UA: asyncua server, its loop  <- opc.tcp |
-    | events' writer threads):           |<====>|   (twin.frontends.opcua.cell_link)                     |
-    |  runner (twin.runtime.pacing) -> exchange  | sock +----------------------------------------------+
-    |  Modbus/TCP server      <- tcp     |<====>| page: viser server, its loop   <- http/ws    |
-    |  watchdog, recorder, a FrontEnd-   | unix |   (twin.frontends.view.process)                        |
-    |  Process per front end below       | sock |                                              |
-    +------------------------------------+      +----------------------------------------------+
-      snapshots (changed values) ->   <- writes (validated here), Sim.Advance, watchdog feeds, buttons
+    twin serve (SCHED_RR where allowed)               its own processes (spawned, ordinary scheduling)
+    +------------------------------------------+      +------------------------------------------------+
+    | one asyncio loop (+ the log's and        | unix | OPC UA: asyncua server, its loop    <- opc.tcp |
+    | events' writer threads):                 |<====>|   (twin.frontends.opcua.cell_link)             |
+    |  runner (twin.runtime.pacing) -> exchange| sock +------------------------------------------------+
+    |  Modbus/TCP server            <- tcp     |<====>| page: viser server, its loop     <- http/ws    |
+    |  watchdog, a FrontEndProcess per front   | unix |   (twin.frontends.view.process)                |
+    |  end on the right, the recorder (rows    | sock +------------------------------------------------+
+    |  kept as read, a pickle per 0.5 s group) |=====>| recorder's writer: encodes, appends -> FILE    |
+    +------------------------------------------+ pipe |   (twin.observe.recording, own session)        |
+      snapshots (changed values) ->   <- writes       +------------------------------------------------+
+      (validated here), Sim.Advance, watchdog feeds, buttons
+
+The recorder's writer is not fed through this adapter (a snapshot a step over it would cost more than the
+encoding it saves: `python -m bench record`); it gets a pipe of its own, one message per half second of
+simulated time, and writes what it received even when the simulation's process dies.
 
 **The adapter.** `FrontEndProcess(name, "module:factory", options)` is a front end of a cell (the contract in
 `twin_app.cell`). `start` spawns a clean interpreter (no pybullet, no loop copied) that calls

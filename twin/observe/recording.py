@@ -15,32 +15,43 @@ the first row the state before the first step (step 0), in the format described 
 text of an enumeration), then `pose:BODY:x|y|z|qx|qy|qz|qw` for every body (each robot and gripper
 link, each target and fixture; world frame, m, quaternion x y z w) and `joint:NAME` for every movable
 joint (m or rad). The file's metadata (`gripper_twin` key, JSON) holds the scene: the station, the step,
-each signal's unit and range, each body's visuals, the fingers.
+each signal's unit and range, each body's visuals, the fingers, the machine's kinematic chain.
+
+The links' poses follow from the joints' positions (rigid links chained by revolute, prismatic and fixed
+joints), so a row stores the joints and only the poses of the bodies that move freely (targets, fixtures:
+`Scene.stored`); they are computed from the joints with pybullet's own joint frames (`twin.observe.scene.link_poses`)
+when the file is read (`Recording`) and when a Parquet file is finished, which then has every pose column.
+A CSV file keeps the stored columns only (`stored_columns`).
 
 Parquet (the default, any name but `.csv`) needs pyarrow (`pip install 'gripper-twin[view]'`): typed
 columns, compressed, read by pandas, polars, DuckDB, Excel's Power Query. A `.csv` file (one header row,
-then one line per step; the scene goes beside it as FILE.csv.json) is written with pyarrow's CSV writer
+then one line per step; the scene goes beside it as FILE.csv.json) is written with Arrow's CSV formatting
 when pyarrow is there, else with Python's. Either way the file depends only on the station and the
 inputs, step by step: a lockstep replay of the same inputs writes the same bytes (no wall time, no host
 name, no random ids).
 
 A flight recorder: what was recorded survives the crash it should explain. Rows are buffered in groups
-of less than `FLUSH_S` (1 s) of simulated time, each written with one system call when it is full (in the
-stepping thread: a fraction of a millisecond per simulated second, and nothing in flight), so after a
-SIGKILL the file holds every step up to less than 1 s before it (the rows of the group being filled). A CSV file gets its lines directly. A Parquet file's footer is
-written only when it is finished, so while recording the file is an Arrow IPC stream (self-delimiting
-record batches, each readable on its own; narrow: the floats of a row in one fixed-size list, so a group
-costs a few buffers, not one per column) and closing converts it into Parquet in place (`finish`). After
-a crash the file is still that stream: `Recording.open` (so `twin plot`, `twin view --replay`,
-`twin snapshot`) reads every complete group of it, `finish(path)` turns it into Parquet. A graceful stop
-keeps every step.
+of less than `FLUSH_S` (0.5 s) of simulated time; a full group goes at once to the recorder's writer process
+(started, and set up, before the first step), which appends it to the file with one system call within
+milliseconds, so after a SIGKILL of the simulation's process the file holds every step up to less than 1 s
+before it (the group being filled, and at most the one the writer is still writing): the writer, in a
+session of its own, writes what it received and exits (`wait_for_writer`: then only the group being filled
+is missing). A CSV file gets its lines
+directly. A Parquet file's footer is written only when it is finished, so while recording the file is an
+Arrow IPC stream (self-delimiting record batches, each readable on its own; narrow: the floats of a row in
+one fixed-size list, so a group costs a few buffers, not one per column) and closing converts it into
+Parquet in place (`finish`). After a crash the file is still that stream: `Recording.open` (so `twin plot`,
+`twin view --replay`, `twin snapshot`) reads every complete group of it, `finish(path)` turns it into
+Parquet. A graceful stop keeps every step.
 
 The recorder is a device of the twin (stepped with it, adding no signals), or, in a served cell, a
 subscriber of the exchange that takes the signals' values from the snapshot already published (`exchange`):
-the core imports nothing of it. What a step costs it: the bodies' poses read from pybullet once (the joints
-and targets the step read itself are taken from the twin, `Twin.step_readings`), the row kept as the tuples
-read; a group's numbers are packed into arrays at once when it is written, and a CSV number is formatted once
-per run of equal values down its column. See `python -m bench record`.
+the core imports nothing of it. What a step costs the simulation's process: no pybullet call (the joints
+and targets the step read itself are taken from the twin, `Twin.step_readings`; the links' poses are not
+read), the row kept as the tuples read, and once per group a pickle of them into a pipe (about a
+microsecond a row). Encoding (Arrow record batches; CSV numbers formatted by Arrow once per run of equal
+values down a column) and writing happen in the writer process (issue 21's rule: what would cost the step
+runs in a process of its own). See `python -m bench record`.
 """
 from __future__ import annotations
 
@@ -50,21 +61,23 @@ import io
 import itertools
 import json
 import math
-import operator
 import os
-import struct
+import pickle
 from itertools import islice
 from pathlib import Path
 
 import numpy as np
 
 from twin.core.errors import TwinError
-from .scene import POSE_FIELDS, Frame, Observer, Scene, attach, detach
+from .scene import POSE_FIELDS, Frame, Observer, Scene, attach, detach, link_poses
 from twin.core.device import ObservingDevice
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: the links' poses are computed from the joints on reading (1: stored per step)
 META_KEY = "gripper_twin"
-FLUSH_S = 1.0  # a group holds less than this much simulated time before it goes to the file (all a crash loses)
+# a group holds less than this much simulated time before it goes to the writer process; a crash loses the group
+# being filled and, read at once, at most the one the writer is still writing: less than 1 s together
+FLUSH_S = 0.5
+START_TIMEOUT = 60.0  # s the writer process may take to start (python, numpy, pyarrow)
 STREAM_MAGIC = b"\xff\xff\xff\xff"  # an Arrow IPC stream's first message starts so; a Parquet file with b"PAR1"
 STREAM_END = b"\xff\xff\xff\xff\x00\x00\x00\x00"  # the end-of-stream mark (written by `close` only)
 PARQUET_ROW_GROUP = 65536
@@ -74,14 +87,34 @@ class RecordingError(TwinError):
     """A recording cannot be written or read (names the file)."""
 
 
-def columns_of(scene: Scene) -> list[tuple[str, str]]:
-    """(column name, type) of a recording of `scene`, in file order; type: int64, float64, bool, string."""
+def columns_of(scene: Scene, bodies: list[str] | None = None) -> list[tuple[str, str]]:
+    """(column name, type) of a recording of `scene`, in file order; type: int64, float64, bool, string.
+    With every body's pose (a finished Parquet file, `Recording`), or those of `bodies` (`stored_columns`)."""
     cols = [("step", "int64"), ("time", "float64")]
     kinds = {"bool": "bool", "float": "float64", "int": "int64", "enum": "string"}
     cols += [(s["name"], kinds.get(s["type"], "float64")) for s in scene.signals]
-    cols += [(f"pose:{b}:{f}", "float64") for b in scene.bodies for f in POSE_FIELDS]
+    cols += [(f"pose:{b}:{f}", "float64") for b in (scene.bodies if bodies is None else bodies) for f in POSE_FIELDS]
     cols += [(f"joint:{j}", "float64") for j in scene.joints]
     return cols
+
+
+def stored_columns(scene: Scene) -> list[tuple[str, str]]:
+    """The columns a row holds while recording (a CSV file, a Parquet recording's stream): the poses only of
+    the bodies the joints do not place (`Scene.stored`)."""
+    return columns_of(scene, scene.stored)
+
+
+def _complete(scene: Scene, columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Stored columns -> every column of `columns_of(scene)`: the links' poses computed from the joints."""
+    if scene.links and f"pose:{scene.links[0]['body']}:x" not in columns:
+        n = len(columns["step"])
+        joints = np.stack([columns[f"joint:{j}"] for j in scene.joints], axis=1) if scene.joints else np.empty((n, 0))
+        derived = link_poses(scene, joints)
+        columns = dict(columns)
+        for k, link in enumerate(scene.links):
+            for f, field in enumerate(POSE_FIELDS):
+                columns[f"pose:{link['body']}:{field}"] = np.ascontiguousarray(derived[:, k, f])
+    return {name: columns[name] for name, _ in columns_of(scene) if name in columns}
 
 
 def is_parquet(path: str | Path) -> bool:
@@ -99,25 +132,16 @@ class _Layout:
     DTYPES = {"float64": np.dtype("<f8"), "bool": np.dtype(bool), "int64": np.dtype("<i8")}
 
     def __init__(self, scene: Scene):
-        self.columns = columns_of(scene)
+        self.columns = stored_columns(scene)
         kinds = [t for _, t in self.columns[2:2 + len(scene.signals)]]
         self.index = {k: [i for i, t in enumerate(kinds) if t == k] for k in self.KINDS}
-        self.n_poses, self.n_joints = 7 * len(scene.bodies), len(scene.joints)
-        # a row's numbers packed by one `struct` call into one record (its numeric signals by kind, then the
-        # poses and joints) that a numpy structured dtype then reads as it is
-        codes = {"float64": "d", "bool": "?", "int64": "q"}
-        numeric = [k for k in ("float64", "bool", "int64") if self.index[k]]
-        order = [i for k in numeric for i in self.index[k]]
-        self._pick_numbers = operator.itemgetter(*order) if len(order) > 1 else (
-            (lambda v, i=order[0]: (v[i],)) if order else (lambda v: ()))
-        self._pick_strings = operator.itemgetter(*self.index["string"]) if len(self.index["string"]) > 1 else (
-            (lambda v, i=self.index["string"][0]: (v[i],)) if self.index["string"] else None)
-        self._row = struct.Struct("<" + "".join(f"{len(self.index[k])}{codes[k]}" for k in numeric)
-                                  + f"{self.n_poses + self.n_joints}d")
-        fields = [(k, self.DTYPES[k], (len(self.index[k]),)) for k in numeric]
-        fields += [("poses", self.DTYPES["float64"], (self.n_poses,)), ("joints", self.DTYPES["float64"], (self.n_joints,))]
-        self._record = np.dtype(fields)
-        assert self._record.itemsize == self._row.size
+        self.n_poses, self.n_joints = 7 * len(scene.stored), len(scene.joints)
+        # a CSV line's columns, as the whole-number block, the float block and the text block hold them
+        signal = [2 + i for i in range(len(kinds))]
+        after = list(range(2 + len(kinds), len(self.columns)))
+        self.csv_order = ([0] + [signal[i] for k in ("bool", "int64") for i in self.index[k]],
+                          [1] + [signal[i] for i in self.index["float64"]] + after,
+                          [signal[i] for i in self.index["string"]])
 
     def schema(self, pa, metadata: dict | None = None):
         types = {"float64": pa.float64(), "bool": pa.bool_(), "int64": pa.int64(), "string": pa.string()}
@@ -129,18 +153,17 @@ class _Layout:
 
     def blocks(self, group: "_Group") -> dict:
         """A group's rows as numpy blocks: step, time, one (rows, width) block per kind of signal, poses, joints.
-        (Each row's numbers packed by one `struct` call into bytes numpy then reads as they are: a third of
-        what numpy's own conversion of a list of tuples costs.)"""
+        (The rows' value tuples become one object array, cut by kind and converted column block by column
+        block: a few numpy calls per group, no Python work per row.)"""
         n = group.n
-        pack, pick = self._row.pack, self._pick_numbers
-        data = b"".join([pack(*pick(v), *p, *j) for v, p, j in zip(group.values, group.poses, group.joints)])
-        records = np.frombuffer(data, self._record, n)
+        values = np.array(group.values, dtype=object).reshape(n, -1)
         out = {"step": np.array(group.steps, dtype=np.int64), "time": np.array(group.times, dtype=float)}
-        for name in self._record.names:
-            out[name] = records[name].reshape(n, -1)
-        if self._pick_strings is not None:
-            out["string"] = np.array([pick for v in group.values for pick in self._pick_strings(v)],
-                                     dtype=object).reshape(n, -1)
+        for kind in self.KINDS:
+            if self.index[kind]:
+                block = values[:, self.index[kind]]
+                out[kind] = block if kind == "string" else block.astype(self.DTYPES[kind])
+        out["poses"] = np.array(group.poses, dtype=float).reshape(n, self.n_poses)
+        out["joints"] = np.array(group.joints, dtype=float).reshape(n, self.n_joints)
         return out
 
     def batch(self, pa, schema, group: "_Group"):
@@ -226,7 +249,7 @@ class Recorder(ObservingDevice):
         self._parquet = is_parquet(self.path)
         self.observer = observer or Observer(twin)
         self.scene = self.observer.scene
-        self.columns = columns_of(self.scene)
+        self.columns = stored_columns(self.scene)  # what a row holds
         self.layout = _Layout(self.scene)
         self.flush_s = flush_s
         self._dt = twin.dt
@@ -243,9 +266,9 @@ class Recorder(ObservingDevice):
             self._open()
         except OSError as exc:
             raise RecordingError(f"{self.path}: cannot write a recording: {exc.strerror or exc}") from None
+        self._writer = _WriterProcess(self.path, self._fd, self.scene)  # it holds the file from here on
+        self._fd = None
         self.capture()  # step 0, or wherever the twin is now
-        if self._pa is not None:  # the writer's first use imports and sets up what it needs: not at a step's cost
-            self._encode(self._group)
         names = [sig["name"] for sig in self.scene.signals]
         if exchange is not None and list(islice(exchange.snapshot.values, len(names))) != names:
             exchange = None  # its snapshot does not list the signals first, in order: read them here
@@ -302,34 +325,17 @@ class Recorder(ObservingDevice):
             header = io.StringIO()
             csv.writer(header, lineterminator="\n").writerow([n for n, _ in self.columns])
             _write_all(self._fd, header.getvalue().encode("utf-8"))
-            if pa is not None:
-                self._schema = self.layout.schema(pa)
 
     def _flush(self) -> None:
-        """Write the buffered group now, in the stepping thread: a write of a few hundred microseconds per
-        simulated second is cheaper than handing it to a thread (and nothing is in flight when the process dies)."""
+        """Hand the buffered group to the writer process now (a pickle of the rows as they are: about a
+        microsecond per row, where encoding them here would cost ten to twenty)."""
         rows, self._group = self._group, _Group(self.layout, self._capacity)
         if rows.n:
-            self._write_group(rows)
-
-    def _write_group(self, rows: _Group) -> None:
-        """A group of rows -> one record batch (Parquet's stream) or lines (CSV), written with one
-        system call."""
-        _write_all(self._fd, self._encode(rows))
-
-    def _encode(self, rows: _Group):
-        """The group as the bytes to write (or a buffer holding them)."""
-        pa = self._pa
-        if self._parquet:  # one stream message: what the stream writer would put after the schema
-            data = memoryview(self.layout.batch(pa, self._schema, rows).serialize())
-        elif pa is not None:
-            data = _csv_lines(pa, self.layout, rows)
-        else:
-            data = _csv_lines_plain(self.layout, rows.rows())
-        return data
+            self._writer.send(("group", rows.steps, rows.times, rows.values, rows.poses, rows.joints))
 
     def close(self) -> None:
-        """Write what is buffered and finish the file (a Parquet file: the stream becomes Parquet)."""
+        """Write what is buffered and finish the file (a Parquet file: the stream becomes Parquet); returns
+        when the file is complete."""
         if self._closed:
             return
         self._closed = True
@@ -340,9 +346,7 @@ class Recorder(ObservingDevice):
         try:
             self._flush()
         finally:
-            os.close(self._fd)
-        if is_parquet(self.path):
-            finish(self.path)
+            self._writer.close()
 
     def __enter__(self) -> "Recorder":
         return self
@@ -351,53 +355,201 @@ class Recorder(ObservingDevice):
         self.close()
 
 
+class _WriterProcess:
+    """The recorder's other half, a process of its own (issue 21's rule: a front end that would cost the step
+    runs beside it): it turns each group of rows into the file's bytes and appends them with one system call.
+    It inherits the open file (header written) and reads the groups from a pipe. When the simulation's process
+    dies, the pipe ends and it writes what it received and exits (in its own session, so a Ctrl-C or a signal
+    to the server's process group leaves it to finish); after a graceful `close` it also finishes the file. It
+    holds an exclusive `flock` on the file while it lives: whoever must read all a crashed run wrote takes a
+    shared one first."""
+
+    def __init__(self, path: Path, fd: int, scene: Scene):
+        import subprocess
+        import sys
+
+        self.path = path
+        read, self._pipe = os.pipe()
+        ready, told = os.pipe()
+        try:
+            import fcntl
+
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # (held by the file's description: the writer's from now)
+            fcntl.fcntl(self._pipe, getattr(fcntl, "F_SETPIPE_SZ", 1031), 1 << 20)  # room for every group in flight
+        except OSError:
+            pass
+        package = str(Path(__file__).resolve().parents[__name__.count(".")])  # the folder `twin` is imported from
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([package] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+        try:
+            self.process = subprocess.Popen(
+                [sys.executable, "-P", "-c", f"from {__name__} import _writer_main; _writer_main()", str(read), str(fd),
+                 str(told), str(path)], pass_fds=(read, fd, told), stdin=subprocess.DEVNULL, env=env,
+                start_new_session=True)
+        except OSError as exc:
+            os.close(self._pipe)
+            os.close(ready)
+            raise RecordingError(f"{path}: cannot start the recorder's process: {exc.strerror or exc}") from None
+        finally:
+            for end in (read, fd, told):
+                os.close(end)
+        try:
+            self.send(("scene", scene.as_dict()))
+            self._wait_ready(ready)
+        except RecordingError:
+            self.process.kill()
+            self.process.wait()
+            os.close(self._pipe)
+            raise
+        finally:
+            os.close(ready)
+
+    def _wait_ready(self, ready: int) -> None:
+        """Wait (before the first step) until it has set itself up: from then on it writes a group within
+        milliseconds of receiving it, so what a crash leaves is on disk almost at once."""
+        import select
+
+        if not select.select([ready], [], [], START_TIMEOUT)[0] or os.read(ready, 1) != b"r":
+            raise RecordingError(f"{self.path}: the recorder's process did not start (exit status "
+                                 f"{self.process.poll()}); see the message it left on stderr")
+
+    def send(self, message: tuple) -> None:
+        try:
+            _write_all(self._pipe, pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL))
+        except OSError:
+            raise RecordingError(f"{self.path}: the recorder's process stopped (exit status "
+                                 f"{self.process.poll()}); see the message it left on stderr") from None
+
+    def close(self) -> None:
+        """Tell it to finish the file, and wait until it has."""
+        try:
+            self.send(("close",))
+        finally:
+            os.close(self._pipe)
+            status = self.process.wait()
+        if status != 0:
+            raise RecordingError(f"{self.path}: the recorder's process failed (exit status {status}); "
+                                 "see the message it left on stderr")
+
+
+class _FileWriter:
+    """In the writer process: a group of rows -> one record batch (a Parquet recording's stream) or lines (CSV),
+    appended with one system call."""
+
+    def __init__(self, fd: int, path: Path, scene: Scene):
+        try:
+            import pyarrow as pa
+        except ImportError:
+            pa = None
+        self.fd, self.path, self.pa = fd, path, pa
+        self.parquet = is_parquet(path)
+        if pa is not None:
+            import pyarrow.compute  # noqa: F401  (set up now, not at the first group)
+        self.layout = _Layout(scene)
+        self.schema = self.layout.schema(pa, {META_KEY: _meta(scene)}) if pa is not None and self.parquet else None
+
+    def write(self, rows: _Group) -> None:
+        _write_all(self.fd, self.encode(rows))
+
+    def encode(self, rows: _Group):
+        """The group as the bytes to write (or a buffer holding them)."""
+        if self.parquet:  # one stream message: what the stream writer would put after the schema
+            return memoryview(self.layout.batch(self.pa, self.schema, rows).serialize())
+        if self.pa is not None:
+            return _csv_lines(self.pa, self.layout, rows)
+        return _csv_lines_plain(self.layout, rows.rows())
+
+
+def _writer_main() -> None:
+    """The writer process (`_WriterProcess`): argv = the pipe it reads, the file, the pipe it says ready on, the
+    file's path."""
+    import signal
+    import sys
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # it ends when its pipe does
+    read, fd, told, path = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), Path(sys.argv[4])
+    closing = False
+    with os.fdopen(read, "rb") as pipe:
+        writer = None
+        while True:
+            try:
+                message = pickle.load(pipe)
+            except (EOFError, pickle.UnpicklingError):  # the simulation's process is gone
+                break
+            if message[0] == "scene":
+                writer = _FileWriter(fd, path, Scene.from_dict(message[1]))
+                os.write(told, b"r")
+                os.close(told)
+            elif message[0] == "group":
+                rows = _Group(writer.layout, len(message[1]))
+                rows.steps, rows.times, rows.values, rows.poses, rows.joints = message[1:]
+                rows.n = len(rows.steps)
+                writer.write(rows)
+            elif message[0] == "close":
+                closing = True
+                break
+    os.close(fd)
+    if closing and is_parquet(path):
+        finish(path)
+
+
+def wait_for_writer(path: str | Path, timeout: float = 10.0) -> bool:
+    """Wait until no recorder's process writes `path` any more (after a crash it writes what it had received,
+    in milliseconds, then exits): True when it is done, False after `timeout` s (it is still recording)."""
+    import fcntl
+    import time
+
+    deadline = time.monotonic() + timeout
+    with open(path, "rb") as f:
+        while True:
+            try:
+                fcntl.flock(f, fcntl.LOCK_SH | fcntl.LOCK_NB)
+                fcntl.flock(f, fcntl.LOCK_UN)
+                return True
+            except BlockingIOError:
+                if time.monotonic() > deadline:
+                    return False
+                time.sleep(0.01)
+
+
 def _write_all(fd: int, data: bytes) -> None:
     while data:
         data = data[os.write(fd, data):]
 
 
-def _csv_lines(pa, layout: _Layout, group: _Group) -> bytes:
-    """A group as CSV lines (no header), formatted by Arrow in a few vectorised calls whatever the column
-    count. A number is formatted once per run of equal values down its column (most signals and the bodies at
-    rest keep theirs from step to step): only the values that changed are cast to text (floats in their
-    shortest form that reads back bit for bit, bools as 1/0); one take puts every cell's text in place and one
-    call per line joins them."""
+def _csv_lines(pa, layout: _Layout, group: _Group):
+    """A group as CSV lines (no header), as one buffer, formatted by Arrow in a dozen vectorised calls whatever
+    the column and row count. The whole numbers (step, bools as 1/0, integers) make one block, the floats (time,
+    signals, poses, joints) another; a number is formatted once per run of equal values down its column (most
+    signals and the bodies at rest keep theirs from step to step): only the values that changed are cast to
+    text (floats in their shortest form that reads back bit for bit) and given the separator that follows them;
+    one take puts every cell's text in place, and the taken texts, laid end to end, are the lines."""
     import pyarrow.compute as pc
 
     b = layout.blocks(group)
     n = group.n
-    parts, places, total = [], {}, 0  # texts to concatenate; per block, each cell's index into them
-
-    def add(key: str, block: np.ndarray, numeric: bool = True) -> None:
-        nonlocal total
-        if numeric:
-            changed, where = _runs(block)
-            text = pa.array(block[changed]).cast(pa.string())
-        else:
-            text, where = pa.array([_csv_field(str(v)) for v in block.ravel()], pa.string()), \
-                np.arange(block.size, dtype=np.int64).reshape(block.shape)
-        parts.append(text)
-        places[key] = where + total
-        total += len(text)
-
-    add("step", b["step"].reshape(n, 1))
-    add("time", b["time"].reshape(n, 1))
-    for kind in layout.KINDS:
-        if layout.index[kind]:
-            add(kind, b[kind].astype(np.int8) if kind == "bool" else b[kind], kind != "string")
-    signals = np.empty((n, sum(len(v) for v in layout.index.values())), dtype=np.int64)
-    for kind in layout.KINDS:
-        if layout.index[kind]:
-            signals[:, layout.index[kind]] = places[kind]  # back in the scene's order
-    for key, width in (("poses", layout.n_poses), ("joints", layout.n_joints)):
-        if width:
-            add(key, b[key])
-    take = np.hstack([places["step"], places["time"], signals] + [places[k] for k in ("poses", "joints") if k in places])
-    cells = pc.take(pa.concat_arrays(parts), pa.array(take.ravel()))
-    width = take.shape[1]
-    ends = pa.array(np.arange(0, n * width + 1, width, dtype=np.int32))
-    lines = pc.binary_join(pa.ListArray.from_arrays(ends, cells), ",")
-    return ("\n".join(lines.to_pylist()) + "\n").encode("utf-8")
+    whole = np.hstack([b["step"].reshape(n, 1)] + [b[k].astype(np.int64) for k in ("bool", "int64") if layout.index[k]])
+    floats = np.hstack([b["time"].reshape(n, 1)] + [b[k] for k in ("float64", "poses", "joints") if k in b and b[k].size])
+    parts, places, total = [], [], 0  # texts to concatenate; per block, each cell's index into them
+    for block in (whole, floats):
+        changed, where = _runs(block)
+        parts.append(pa.array(block[changed]).cast(pa.string()))
+        places.append(where + total)
+        total += len(parts[-1])
+    if layout.index["string"]:
+        parts.append(pa.array([_csv_field(str(v)) for v in b["string"].ravel()], pa.string()))
+        places.append(np.arange(b["string"].size, dtype=np.int64).reshape(n, -1) + total)
+        total += len(parts[-1])
+    take = np.empty((n, len(layout.columns)), dtype=np.int64)
+    for columns, where in zip(layout.csv_order, places):
+        take[:, columns] = where
+    texts = pa.concat_arrays(parts)
+    # every text with a comma after it; the last column's cells with the line's end instead
+    ends = pc.binary_join_element_wise(pc.take(texts, pa.array(take[:, -1])), "\n", "")
+    texts = pa.concat_arrays([pc.binary_join_element_wise(texts, ",", ""), ends])
+    take[:, -1] = total + np.arange(n)
+    cells = pc.take(texts, pa.array(take.ravel()))
+    offsets = np.frombuffer(cells.buffers()[1], dtype=np.int32)[cells.offset:cells.offset + len(cells) + 1]
+    return memoryview(cells.buffers()[2])[offsets[0]:offsets[-1]]
 
 
 def _runs(block: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -466,10 +618,11 @@ def finish(path: str | Path) -> Path:
         raise RecordingError(f"{path}: an Arrow stream without gripper-twin metadata: not a recording")
     scene = Scene.from_dict(json.loads(meta)["scene"])
     layout = _Layout(scene)
-    wide = layout.wide(pa, narrow)
+    wide = _complete(scene, layout.wide(pa, narrow))
     types = {"int64": pa.int64(), "float64": pa.float64(), "bool": pa.bool_(), "string": pa.string()}
-    out_schema = pa.schema([(n, types[t]) for n, t in layout.columns], metadata={META_KEY: meta})
-    table = pa.Table.from_arrays([pa.array(wide[n], types[t]) for n, t in layout.columns], schema=out_schema)
+    full = columns_of(scene)
+    out_schema = pa.schema([(n, types[t]) for n, t in full], metadata={META_KEY: meta})
+    table = pa.Table.from_arrays([pa.array(wide[n], types[t]) for n, t in full], schema=out_schema)
     tmp = path.with_name(path.name + ".finishing")
     pq.write_table(table, str(tmp), compression="zstd", row_group_size=PARQUET_ROW_GROUP)
     os.replace(tmp, path)
@@ -561,7 +714,7 @@ class Recording:
             if stream:
                 import pyarrow as pa
 
-                columns = _Layout(scene).wide(pa, table)
+                columns = _complete(scene, _Layout(scene).wide(pa, table))
             else:
                 columns = {name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names}
         else:
@@ -569,7 +722,7 @@ class Recording:
             if not meta_path.is_file():
                 raise RecordingError(f"{path}: its scene file {meta_path.name} is missing beside it")
             scene = Scene.from_dict(json.loads(meta_path.read_text(encoding="utf-8"))["scene"])
-            kinds = dict(columns_of(scene))
+            kinds = dict(stored_columns(scene))
             with open(path, newline="", encoding="utf-8") as f:
                 text = f.read()
             text = text[:text.rfind("\n") + 1]  # a line cut short by a crash is not a row
@@ -589,6 +742,7 @@ class Recording:
                     columns[name] = np.array(col, dtype=object)
                 else:
                     columns[name] = np.array([float(v) for v in col], dtype=float)
+            columns = _complete(scene, columns)
         missing = [n for n, _ in columns_of(scene) if n not in columns]
         if missing:
             raise RecordingError(f"{path}: columns missing: {', '.join(missing[:5])}")

@@ -6,7 +6,11 @@ threads. They read frames taken by an `Observer`, which the stepping thread call
 
 A frame holds every signal's value (SI units, in the signal table's order), the pose of every body
 (each link of the robot-and-gripper multibody, each target and fixture: position and quaternion x, y,
-z, w in the world frame) and the position of every movable joint. The scene describes, once, what
+z, w in the world frame) and the position of every movable joint. The links of the machine are rigid
+bodies chained by revolute, prismatic and fixed joints, so their poses follow from the joints' positions:
+the scene holds that chain (`Scene.links`, from pybullet's own joint frames) and `link_poses` computes
+them, for all the rows of a recording at once; a recorder stores per step only the joints and the poses
+of the bodies that move freely (targets, fixtures: `Scene.stored`). The scene describes, once, what
 each body looks like: the URDF visuals as pybullet loaded them (boxes, cylinders, spheres, capsules,
 meshes, planes; their colours and local frames), and for each finger its links, the chain of joints
 that moves it (axis, type, which input drives it), so a front end can draw a finger where its setpoint
@@ -72,6 +76,16 @@ class Scene:
     fixtures: list[str]
     robot_targets: dict[str, list[float]] = field(default_factory=dict)  # name -> x, y, z, qx, qy, qz, qw
     signals: list[dict] = field(default_factory=list)  # name, direction, type, unit, min, max, group, choices
+    # the machine's kinematic chain, parents first: body, parent (None: the world), joint, type (fixed,
+    # revolute, prismatic), origin (the body's frame in its parent's at joint position 0: x y z qx qy qz qw),
+    # axis (in the body's frame). A body listed here has its pose computed from the joints (`link_poses`).
+    links: list[dict] = field(default_factory=list)
+
+    @property
+    def stored(self) -> list[str]:
+        """The bodies whose poses a recording stores per step (the others follow from the joints)."""
+        derived = {link["body"] for link in self.links}
+        return [b for b in self.bodies if b not in derived]
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -146,6 +160,7 @@ class Observer:
             fixtures=[f.name for f in st.fixtures],
             robot_targets={n: [*p.xyz, *c.getQuaternionFromEuler(p.rpy)] for n, p in st.robot_targets.items()},
             signals=[_signal_dict(s) for s in twin.signals])
+        self.scene.links = self._kinematics(c, world.machine, joint_info, link_name, self._base_pose)
         self._names = [s.name for s in twin.signals]
         self._base_pose_t = tuple(float(v) for v in self._base_pose)
         # a fixture of mass 0 is static in pybullet (nothing moves it; only targets are placed and displaced):
@@ -169,6 +184,30 @@ class Observer:
         elif shape in ("cylinder", "capsule"):
             size = size[:2]
         return Visual(body, shape, size, mesh, tuple(v[5]), tuple(v[6]), tuple(float(x) for x in v[7]))
+
+    @staticmethod
+    def _kinematics(c, machine: int, joint_info, link_name, base_pose) -> list[dict]:
+        """The machine's chain as `Scene.links` lists it, from pybullet's model: a link's centre-of-mass frame
+        is its parent's, moved to the joint and turned by the joint's frame (getJointInfo gives the inverse
+        rotation), then moved along or turned about the axis (given in the child's centre-of-mass frame); a
+        link's own frame is its centre-of-mass frame less its inertial offset. Here both are expressed from link
+        frame to link frame. (The world loads every joint as revolute, prismatic or fixed: `twin.core.mechanism`
+        makes planar, floating and spherical ones rigid.)"""
+        links = [{"body": link_name[-1], "parent": None, "joint": "", "type": "fixed",
+                  "origin": [float(v) for v in base_pose], "axis": [0.0, 0.0, 0.0]}]
+        kinds = {0: "revolute", 1: "prismatic", 4: "fixed"}
+        for info in joint_info:  # pybullet numbers a link after its parent
+            j, parent = info[0], info[16]
+            inertial_pos, inertial_orn = c.getDynamicsInfo(machine, parent)[3:5]
+            ix, iy, iz, iw = c.getDynamicsInfo(machine, j)[4]
+            fx, fy, fz, fw = info[15]
+            orn = quat_multiply(quat_multiply(inertial_orn, (-fx, -fy, -fz, fw)), (-ix, -iy, -iz, iw))
+            pos = np.asarray(inertial_pos, dtype=float) + quat_to_matrix(inertial_orn) @ np.asarray(info[14], dtype=float)
+            axis = quat_to_matrix((ix, iy, iz, iw)) @ np.asarray(info[13], dtype=float)
+            links.append({"body": link_name[j], "parent": link_name[parent], "joint": info[1].decode(),
+                          "type": kinds[info[2]], "origin": [*(float(v) for v in pos), *(float(v) for v in orn)],
+                          "axis": [float(a) for a in axis]})
+        return links
 
     @staticmethod
     def _fingers(twin, joint_info, link_name) -> list[FingerView]:
@@ -200,38 +239,19 @@ class Observer:
         return fingers
 
     def raw(self, values: tuple | None = None) -> tuple:
-        """The state now as plain sequences: (step, time, values, poses flat (x y z qx qy qz qw per body), joints).
+        """What a recorder keeps of the state now: (step, time, values, the poses of `scene.stored` flat (x y z
+        qx qy qz qw per body), joints) as plain sequences.
 
-        The cheap form a recorder keeps for every step; `frame()` makes a `Frame` of it. `values`: the
-        signals' values in `scene.signals`' order when the caller has them already (a published snapshot).
-        What the step itself read (the joints' positions, the targets' poses: `Twin.step_readings`) is taken
-        from it, not asked of pybullet again: the same numbers, bit for bit, for a fraction of the cost."""
+        `values`: the signals' values in `scene.signals`' order when the caller has them already (a published
+        snapshot). What the step itself read (the joints' positions, the targets' poses: `Twin.step_readings`)
+        is taken from it, not asked of pybullet again: the same numbers, bit for bit, for a fraction of the
+        cost. The links' poses are not read (they follow from the joints: `link_poses`)."""
         twin, cid, pybullet = self.twin, self._cid, self._pb
         if values is None:
             read = twin.read
             values = tuple([read(n) for n in self._names])
         readings = twin.step_readings() if twin.step_count else None
-        poses = list(self._base_pose_t)
-        # pybullet's functions called directly with the connection's id: BulletClient's per-call wrapper
-        # costs more than the calls themselves
-        if self._link_indices:
-            # after a step pybullet's link frames are current; before the first one, compute them
-            states = pybullet.getLinkStates(self._machine, self._link_indices,
-                                            computeForwardKinematics=not twin.step_count, physicsClientId=cid)
-            for s in states:
-                poses += s[4]
-                poses += s[5]
-        static = self._static_pose
-        known = dict(zip(readings[2], readings[3])) if readings is not None else {}
-        for uid in self._other_ids:
-            if uid in static:
-                poses += static[uid]
-                continue
-            pose = known.get(uid)
-            if pose is None:
-                pose = pybullet.getBasePositionAndOrientation(uid, physicsClientId=cid)
-            poses += pose[0]
-            poses += pose[1]
+        poses = self._other_poses(readings)
         if not self._joint_indices:
             joints = ()
         elif readings is not None and readings[0] == self._joint_indices:
@@ -245,8 +265,40 @@ class Observer:
             joints = tuple([have[j] for j in self._joint_indices])
         return twin.step_count, twin.time, values, poses, joints
 
-    def frame(self, raw: tuple | None = None) -> Frame:
-        step, t, values, poses, joints = raw if raw is not None else self.raw()
+    def _link_states(self, indices: list[int]) -> list[float]:
+        """The links' frames where the joints put them now (x y z qx qy qz qw each, flat): what a recording
+        computes from its joints (pybullet's cached frames lag the joints by the step's last substep;
+        computing them changes nothing in the simulation)."""
+        # pybullet's functions called directly with the connection's id: BulletClient's per-call wrapper
+        # costs more than the calls themselves
+        poses = []
+        for s in self._pb.getLinkStates(self._machine, indices, computeForwardKinematics=True,
+                                        physicsClientId=self._cid):
+            poses += s[4]
+            poses += s[5]
+        return poses
+
+    def _other_poses(self, readings) -> list[float]:
+        poses, static = [], self._static_pose
+        known = dict(zip(readings[2], readings[3])) if readings is not None else {}
+        for uid in self._other_ids:
+            if uid in static:
+                poses += static[uid]
+                continue
+            pose = known.get(uid)
+            if pose is None:
+                pose = self._pb.getBasePositionAndOrientation(uid, physicsClientId=self._cid)
+            poses += pose[0]
+            poses += pose[1]
+        return poses
+
+    def frame(self) -> Frame:
+        """The state now with every body's pose (the live page's picture), read from pybullet."""
+        step, t, values, stored, joints = self.raw()
+        poses = list(self._base_pose_t)
+        if self._link_indices:
+            poses += self._link_states(self._link_indices)
+        poses += stored
         return Frame(step, t, values, np.asarray(poses, dtype=float).reshape(len(self.scene.bodies), 7),
                      np.asarray(joints, dtype=float))
 
@@ -305,6 +357,82 @@ def detach(twin, device) -> None:
 
 
 # -- pose arithmetic for front ends (numpy, quaternions x, y, z, w) ---------------------------------------------
+def quat_multiply(a, b) -> tuple[float, float, float, float]:
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz)
+
+
+def link_poses(scene: Scene, joints: np.ndarray) -> np.ndarray:
+    """The pose of each body of `scene.links` for each row of joint positions (rows, len(scene.joints)):
+    (rows, len(scene.links), 7), x y z qx qy qz qw in the world frame; all rows at once."""
+    joints = np.asarray(joints, dtype=float).reshape(-1, len(scene.joints))
+    n = joints.shape[0]
+    column = {name: k for k, name in enumerate(scene.joints)}
+    frames: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # body -> (rotations (n, 3, 3), positions (n, 3))
+    out = np.empty((n, len(scene.links), 7))
+    for k, link in enumerate(scene.links):
+        origin = np.asarray(link["origin"], dtype=float)
+        turn = quat_to_matrix(origin[3:])
+        rot, pos = np.broadcast_to(turn, (n, 3, 3)), np.broadcast_to(origin[:3], (n, 3))
+        if link["type"] != "fixed":
+            axis = np.asarray(link["axis"], dtype=float)
+            q = joints[:, column[link["joint"]]]
+            if link["type"] == "prismatic":  # (as pybullet moves it: by the axis as long as it is given)
+                pos = pos + (turn @ axis) * q[:, None]
+            else:
+                rot = rot @ _rotations(axis / np.linalg.norm(axis), q)
+        if link["parent"] is not None:
+            parent_rot, parent_pos = frames[link["parent"]]
+            pos = parent_pos + np.einsum("nij,nj->ni", parent_rot, pos)
+            rot = parent_rot @ rot
+        frames[link["body"]] = (rot, pos)
+        out[:, k, :3] = pos
+        out[:, k, 3:] = matrices_to_quats(rot)
+    return out
+
+
+def _rotations(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations by each angle about a unit axis (Rodrigues)."""
+    x, y, z = axis
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
+    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+
+
+def matrices_to_quats(m: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations -> (n, 4) quaternions x y z w, the sign chosen as Bullet chooses it (so a computed
+    pose reads like one pybullet gives)."""
+    n = m.shape[0]
+    q = np.empty((n, 4))
+    trace = m[:, 0, 0] + m[:, 1, 1] + m[:, 2, 2]
+    pos = trace > 0
+    if pos.any():
+        a = m[pos]
+        s = np.sqrt(trace[pos] + 1.0)
+        q[pos, 3] = 0.5 * s
+        s = 0.5 / s
+        q[pos, 0] = (a[:, 2, 1] - a[:, 1, 2]) * s
+        q[pos, 1] = (a[:, 0, 2] - a[:, 2, 0]) * s
+        q[pos, 2] = (a[:, 1, 0] - a[:, 0, 1]) * s
+    d0, d1, d2 = m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]
+    big = np.where(d0 < d1, np.where(d1 < d2, 2, 1), np.where(d0 < d2, 2, 0))
+    for i in range(3):
+        sel = ~pos & (big == i)
+        if not sel.any():
+            continue
+        j, k = (i + 1) % 3, (i + 2) % 3
+        a = m[sel]
+        s = np.sqrt(a[:, i, i] - a[:, j, j] - a[:, k, k] + 1.0)
+        q[sel, i] = 0.5 * s
+        s = 0.5 / s
+        q[sel, 3] = (a[:, k, j] - a[:, j, k]) * s
+        q[sel, j] = (a[:, j, i] + a[:, i, j]) * s
+        q[sel, k] = (a[:, k, i] + a[:, i, k]) * s
+    return q
+
+
 def quat_to_matrix(q) -> np.ndarray:
     x, y, z, w = q
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
