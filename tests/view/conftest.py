@@ -24,9 +24,10 @@ def chromium_path() -> str | None:
     return None
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def browser():
-    """A headless Chromium (skips the test when there is none)."""
+    """A headless Chromium (skips the test when there is none), one per test module: Playwright's sync API keeps an event
+    loop marked running in this thread until it exits, which would break later tests that call asyncio.run."""
     try:
         from playwright.sync_api import sync_playwright
     except ImportError:
