@@ -612,3 +612,72 @@ def test_a_finger_mass_denser_than_any_metal_is_warned_of_naming_the_link(tmp_pa
             doctor.densities()
         warned = {c.who for c in doctor.report.checks if c.level == "WARN" and c.measure == "mass"}
         assert warned == ({"jaw_a", "jaw_b"} if heavy else set()), doctor.report.checks
+
+
+def mesh_contact_angle(finger: str, peg: dict, mount_xyz) -> float:
+    """Where the PR2 finger's STL (read by trimesh) first meets the peg's nominal box, closing from 0.5 rad: the joint
+    angle, by bisection, the finger placed by pybullet's kinematics of the URDF as pybullet_data ships it."""
+    import numpy as np
+    import pybullet
+
+    from tests.core.test_mesh_fingers import URDF, collision_mesh, surface_points
+
+    vertices, faces = collision_mesh(finger)
+    half, centre = np.array(peg["size"]) / 2, np.array(peg["xyz"])
+    c = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(str(URDF), mount_xyz, useFixedBase=True, physicsClientId=c)
+        joint = next(j for j in range(pybullet.getNumJoints(body, physicsClientId=c))
+                     if pybullet.getJointInfo(body, j, physicsClientId=c)[12].decode() == finger)
+
+        def sdf(q, points):
+            pybullet.resetJointState(body, joint, q, physicsClientId=c)
+            frame = pybullet.getLinkState(body, joint, computeForwardKinematics=True, physicsClientId=c)
+            rot = np.array(pybullet.getMatrixFromQuaternion(frame[5])).reshape(3, 3)
+            d = np.abs(points @ rot.T + frame[4] - centre) - half
+            return np.linalg.norm(np.maximum(d, 0), axis=1) + np.minimum(d.max(axis=1), 0)
+
+        def bisect(points, lo, hi):  # touching at lo, free at hi
+            for _ in range(20):
+                mid = (lo + hi) / 2
+                lo, hi = (mid, hi) if sdf(mid, points).min() <= 0 else (lo, mid)
+            return hi
+
+        # the vertices meet it at q_v, the surface (which holds them) no later: only the triangles with a point
+        # within 2 mm of the peg there (looked for 1 mm apart) are sampled finely
+        q_v = bisect(vertices, 0.0, 0.5)
+        near = [k for k, face in enumerate(faces)
+                if sdf(q_v, surface_points(vertices, faces[k:k + 1], 0.001)).min() < 0.002]
+        fine = surface_points(vertices, faces[near], 0.0002)
+        return bisect(fine[sdf(q_v, fine) < 0.002], q_v, 0.5)
+    finally:
+        pybullet.disconnect(c)
+
+
+def test_mesh_fingers_meet_the_part_where_their_mesh_does_and_pass(tmp_path, capsys):
+    """pybullet_data's PR2 gripper on a peg between its mesh pads (tests/grippers/pr2_mesh, 2 N m a finger): the
+    doctor's contact geometry is where the STL itself meets the peg (pybullet's hull grown by its 1 mm margin met it
+    0.5 degrees early here), and every check passes: status 2, a still finger, 2 N m within 10 %, in by < 0.5 mm."""
+    folder = station("pr2_mesh")
+    toml = tomllib.loads((folder / "station.toml").read_text())
+    code, text, report = run_check(folder, tmp_path, capsys)
+    assert code == 0, text
+    for f in grip(report, "peg", "outside")["fingers"]:
+        q = mesh_contact_angle(f["finger"], toml["targets"][0], toml["gripper"]["mount"]["xyz"])
+        assert f["contact_geometry"] == pytest.approx(q, abs=0.0003 / 0.08), f  # 0.3 mm at the pad, 80 mm out
+        assert f["force"] == pytest.approx(toml["gripper"]["joints"][f["finger"]]["effort"], rel=0.1)
+
+
+def test_a_placeholder_effort_is_a_warning_naming_the_station_key_and_the_force_fails(tmp_path, capsys):
+    folder = tmp_path / "pr2"
+    folder.mkdir()
+    text = (station("pr2_mesh") / "station.toml").read_text()
+    for finger in ("left_gripper", "right_gripper"):
+        text = text.replace(f"[gripper.joints.{finger}]\neffort = 2.0\n", "")
+    (folder / "station.toml").write_text(text)
+    code, out, report = run_check(folder, tmp_path, capsys)
+    assert code == 1, out
+    for finger in ("left_gripper", "right_gripper"):
+        assert any(f"input {finger}: effort 1000 N m cannot be reached" in ln and f"[gripper.joints.{finger}] effort"
+                   in ln for ln in lines(out, "WARN")), out
+        assert any(f" {finger} force: " in ln for ln in lines(out, "FAIL")), out
