@@ -71,7 +71,7 @@ def test_the_first_finger_pushes_an_off_centre_part_along_without_kicking_it_ahe
     first, second = sorted(TINY.fingers, key=touch.get)
     gaps = [-TINY.penetration(q, pose)[first] for q, pose in zip(rec["q"], rec["pose"])][touch[first]:touch[second]]
     assert touch[second] > touch[first]
-    assert max(gaps) < 0.3e-3
+    assert max(gaps) < 0.1e-3  # (a kicked one ran 0.5 to 1.7 mm ahead)
 
 
 def test_an_off_centre_part_is_held_with_each_fingers_effort_within_10_steps_of_the_second_touch(offset_grip):
