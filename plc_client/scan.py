@@ -240,28 +240,49 @@ class TwinIO(LocalSignals):
     """A twin in the same process as the PLC (tests, quick trials): lockstep, no network.
 
     Values are published in the register map's engineering units (metres as mm) so the same logic runs
-    here and over the network. `local`: signals the PLC holds itself (see `LocalSignals`).
+    here and over the network. `local`: signals the PLC holds itself (see `LocalSignals`). `wire`: a register
+    map (the one a server of this twin serves, `twin.modbus.register_map.RegisterMap`) whose resolution the
+    values take both ways, encoded and decoded as on the wire: the logic reads and writes exactly what it
+    would over Modbus, so the run is the same, bit for bit, as against `twin serve` (plain engineering values
+    in full precision otherwise).
     """
 
     lockstep = True
     SCALE = {"m": 1000.0}  # SI unit -> factor to the map's unit (m -> mm)
 
-    def __init__(self, twin, local: Mapping[str, Any] | None = None):
+    def __init__(self, twin, local: Mapping[str, Any] | None = None, *, wire=None):
         super().__init__(local)
         self.twin = twin
         self._scale = {s.name: self.SCALE.get(s.unit, 1.0) for s in twin.signals}
+        self._wire, self._entries = wire, None
+        if wire is not None:
+            from .checks import check_value  # plc_client.client imports this module: these come in here
+            from .client import decode, encode
+
+            self._entries = {e.name: e for e in wire if e.signal is not None}
+            self._decode, self._encode, self._check = decode, encode, check_value
         self._time = 0.0  # s the PLC asked to advance, carried over to whole steps
         self._steps = 0
 
     def _read(self, names: list[str]) -> dict[str, Any]:
         out = {}
+        read, entries = self.twin.read, self._entries
         for n in names:
-            v = self.twin.read(n)
-            out[n] = v * self._scale[n] if isinstance(v, float) else v
+            v = read(n)
+            entry = entries.get(n) if entries is not None else None
+            if entry is not None:  # what a read over Modbus gives: the server's words, the client's decoding
+                out[n] = self._decode(entry, entry.encode(v))
+            else:
+                out[n] = v * self._scale[n] if isinstance(v, float) else v
         return out
 
     def _write(self, values: dict[str, Any]) -> None:
+        entries = self._entries
         for n, v in values.items():
+            entry = entries.get(n) if entries is not None else None
+            if entry is not None:  # the words a write over Modbus sends, taken as the server takes them
+                self.twin.write(n, entry.si_of_words(self._encode(entry, self._check(self._wire, n, v))))
+                continue
             if isinstance(v, (int, float)) and not isinstance(v, bool):
                 self.twin.write(n, v / self._scale[n])
             else:

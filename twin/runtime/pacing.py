@@ -1,8 +1,8 @@
 """Runners that pace a stepped simulation: the only module that knows the wall clock.
 
 The core (`twin.core`) has no clock: its time is step count x dt. Something has to decide *when* to
-step. Two runners do, both as asyncio tasks that share the event loop with the server that exposes
-the simulation (so a step and a request never interleave: a read sees a completed step):
+step. Two runners do, both on the event loop they share with the server that exposes the simulation
+(so a step and a request never interleave: a read sees a completed step):
 
 - `RealtimeRunner(step, dt, speed)`: step k is due at t0 + k * dt / speed on the wall clock. The runner
   sleeps until a step's start time, runs it, and counts it *late* when it finishes after its due time
@@ -143,7 +143,10 @@ class RealtimeRunner:
 
 
 class LockstepRunner:
-    """Step only on request (`request(n)`), as fast as possible, yielding to the server between steps."""
+    """Step only on request (`request(n)`), as fast as possible, yielding to the server between slices of steps.
+
+    It runs as plain callbacks of the event loop (`call_soon`), not as a task woken through an event: a request
+    costs one turn of the loop before its steps, and the answer waiting for them goes out from the last one."""
 
     mode = "lockstep"
     speed = 0.0
@@ -155,7 +158,9 @@ class LockstepRunner:
         self.steps = 0
         self.target = 0
         self._done: list[Callable[[], None]] = []  # called when the steps asked for are done (or failed)
-        self._wake: asyncio.Event | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None  # while `run()` runs
+        self._scheduled = False  # a slice is due on the loop
+        self._finished: asyncio.Future | None = None  # `run()` waits on it: stopped, or the simulation failed
         self._stop = False
         self.failed = False
 
@@ -167,8 +172,7 @@ class LockstepRunner:
         if self.failed:
             return
         self.target += n
-        if self._wake is not None:
-            self._wake.set()
+        self._schedule()
 
     def when_done(self, callback: Callable[[], None]) -> None:
         """Call `callback()` once every step asked for so far has run (at once when none is left)."""
@@ -182,32 +186,57 @@ class LockstepRunner:
         for callback in done:
             callback()
 
-    def stop(self) -> None:
-        self._stop = True
-        if self._wake is not None:
-            self._wake.set()
-        self._call_done()
+    def _schedule(self) -> None:
+        if self._loop is not None and not self._scheduled and not self._stop and self.steps < self.target:
+            self._scheduled = True
+            self._loop.call_soon(self._slice)
 
-    async def run(self) -> None:
-        self._wake = asyncio.Event()
+    def _slice(self) -> None:
+        """Steps back to back for up to `slice_s` of wall time; then the loop's turn (the server answers) and
+        the next slice."""
+        self._scheduled = False
+        if self._stop:
+            return
         clock = self.clock
-        while not self._stop:
-            if self.steps >= self.target:
-                if self._done:
-                    self._call_done()
-                self._wake.clear()
-                await self._wake.wait()
-                continue
-            t_yield = clock() + self.slice_s
+        t_yield = clock() + self.slice_s
+        try:
             while self.steps < self.target and not self._stop:
                 if not self.step():
                     self.failed = True
                     self.target = self.steps
                     self._call_done()
+                    self._end()
                     return
                 self.steps += 1
                 if self.steps >= self.target and self._done:
                     self._call_done()
                 if clock() >= t_yield:
                     break
-            await asyncio.sleep(0)
+        except BaseException as exc:  # noqa: BLE001 - `run()` raises it, as a task running the steps would
+            self._end(exc)
+            return
+        self._schedule()
+
+    def _end(self, exc: BaseException | None = None) -> None:
+        if self._finished is not None and not self._finished.done():
+            if exc is None:
+                self._finished.set_result(None)
+            else:
+                self._finished.set_exception(exc)
+
+    def stop(self) -> None:
+        self._stop = True
+        self._end()
+        self._call_done()
+
+    async def run(self) -> None:
+        """Step whatever is asked for until `stop()`, or until a step fails (`failed`)."""
+        self._loop = asyncio.get_running_loop()
+        self._finished = self._loop.create_future()
+        if self._stop:
+            self._finished.set_result(None)
+        self._schedule()
+        try:
+            await self._finished
+        finally:
+            self._loop = None

@@ -36,7 +36,10 @@ class TwinBridge:
         self._advance = rmap[ADVANCE] if ADVANCE in rmap else None
         self.live_addresses = frozenset({self._advance.address} if self._advance is not None else ())
         self.crc = rmap.crc  # sim.map_crc: the CRC of the map this front end serves
-        self._encoded: dict[int, tuple[object, list[int]]] = {}  # id(entry): the map outlives it
+        # the images as of the last snapshot, kept between publishes: a publish re-encodes only the values that
+        # changed (most do not from one step to the next) into them
+        self._buffers = {t: bytearray(size if t in BIT_TABLES else 2 * size) for t, size in self._sizes.items()}
+        self._last = {t: [_UNSET] * len(entries) for t, entries in self._keyed.items()}
         self.images: Images = Images(b"", b"", b"", b"")
         self.publish(exchange.snapshot)
         self._unsubscribe = exchange.subscribe(on_snapshot=self.publish, on_writes=self._show_written)
@@ -107,25 +110,25 @@ class TwinBridge:
     def publish(self, snapshot: Snapshot | None = None) -> None:
         """New images from a snapshot (default: the exchange's latest), with the writes still queued on top."""
         values = (snapshot or self.exchange.snapshot).values
-        crc = self.crc
+        get, crc = values.get, self.crc
         images = {}
         for table, entries in self._keyed.items():
-            size = self._sizes[table]
+            buf, last = self._buffers[table], self._last[table]
             if table in BIT_TABLES:
-                img = bytearray(size)
                 for e, key in entries:
-                    img[e.address] = 1 if values.get(key, 0) else 0
-                images[table] = bytes(img)
+                    buf[e.address] = 1 if get(key, 0) else 0
             else:
-                words = [0] * size
-                encoded = self._encoded  # entry -> (value, words): most values do not change from step to step
-                for e, key in entries:
-                    v = crc if key == MAP_CRC else values.get(key, 0)
-                    last = encoded.get(id(e))
-                    if last is None or last[0] != v or type(last[0]) is not type(v):
-                        last = encoded[id(e)] = (v, e.encode(v))
-                    words[e.address:e.end] = last[1]
-                images[table] = struct.pack(f">{size}H", *words)
+                for i, (e, key) in enumerate(entries):
+                    v = crc if key == MAP_CRC else get(key, 0)
+                    old = last[i]
+                    if old is v or (old == v and type(old) is type(v)):
+                        continue
+                    last[i] = v
+                    e.pack_into(buf, 2 * e.address, v)
+            images[table] = bytes(buf)
         self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
         for batch in self.exchange.pending:  # written but not yet applied (empty after a step): still reads as written
             self._show_written(batch)
+
+
+_UNSET = object()  # no value encoded yet

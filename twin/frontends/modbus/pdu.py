@@ -111,8 +111,10 @@ class ImageLayout:
       (discrete input 16*k + i is bit i of word k), the input registers one to one, the coils packed like
       the discrete inputs, then the holding registers one to one. Unmapped addresses read 0.
     - The output window (from 0xC000): one word per coil (0 or 1), then the holding registers one to one.
-      A write here is a write of the entries it covers, all or nothing, checked as any write; words over
-      unmapped addresses are ignored, a read-only entry may only be written with the value it has."""
+      A write here is a write of the entries it covers whose words differ from what they read, all or
+      nothing, checked as any write; an entry written with the words it reads is left as it is (a PLC
+      writes its whole output image every scan), words over unmapped addresses are ignored, a read-only
+      entry may only be written with the value it has."""
 
     def __init__(self, sizes: dict[str, int]):
         self.sizes = dict(sizes)
@@ -410,7 +412,8 @@ class PduHandler:
             if not e.writable:
                 if not same:
                     return ILLEGAL_DATA_ADDRESS
-            else:
+            elif not same or e.signal is None:  # words written back as they read are no change (a PLC rewrites
+                # its whole image), but the simulator's own entries are commands (sim.advance: N more steps)
                 value = e.si_of_words(chunk)
                 if value is None:
                     return ILLEGAL_DATA_VALUE

@@ -176,15 +176,30 @@ class Entry:
         if self.type == "float32":
             return float(value) * factor
         v = float(value) * factor / self.scale
-        if math.isnan(v):
+        if v != v:  # NaN
             return 0
+        lo, hi = self._saturation
+        return lo if v <= lo else hi if v >= hi else int(round(v))
+
+    @cached_property
+    def _saturation(self) -> tuple[int, int]:
+        """The counts a value saturates at: its type's limits; an output a hair past its declared range (a finger
+        pressed past its limit) reads as the range's end."""
         lo, hi = TYPE_LIMITS[self.type]
-        if self.access == "r":  # an output a hair past its declared range (a finger pressed past its limit) reads as the limit
+        if self.access == "r":
             if self.min is not None:
                 lo = max(lo, math.ceil(self.min / self.scale - 1e-9))
             if self.max is not None:
                 hi = min(hi, math.floor(self.max / self.scale + 1e-9))
-        return lo if v <= lo else hi if v >= hi else int(round(v))
+        return lo, hi
+
+    @cached_property
+    def _packer(self) -> struct.Struct:
+        return struct.Struct(">H" if self.type in ("bool", "uint16") else _STRUCT[self.type])
+
+    def pack_into(self, buffer, offset: int, value, *, engineering: bool = False) -> None:
+        """`encode`'s words written big-endian into `buffer` at byte `offset` (a register image)."""
+        self._packer.pack_into(buffer, offset, self.counts_of(value, engineering=engineering))
 
     def encode(self, value, *, engineering: bool = False) -> list[int]:
         """SI value -> register words (big-endian, high word first), or [0/1] for a bit. `engineering`: the
