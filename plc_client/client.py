@@ -405,14 +405,16 @@ class TwinClient:
         r = self._call(3, "read_holding_registers", IMAGE_IN, n, (), count=n)
         return WindowImage(self, list(r.registers))
 
-    def exchange(self, values: Mapping[str, Any], image: "WindowImage", advance: int = 0) -> "WindowImage":
+    def exchange(self, values: Mapping[str, Any], image: "WindowImage", advance: int = 0, *,
+                 checked: bool = False) -> "WindowImage":
         """Write `values` (names in engineering units, and `advance` steps of sim.advance) into the output
         window and read the whole input window back, in one function 23. In lockstep with `advance`, the
         server answers once the steps are done, so the image returned is the state after them. `image`
-        (the last one read) gives the current values of the words between the ones written."""
+        (the last one read) gives the current values of the words between the ones written. `checked`: the
+        values have passed `check_value` already (a scan's outputs, checked when the scan set them)."""
         from twin.frontends.modbus.pdu import IMAGE_IN, IMAGE_OUT
 
-        words = self._out_words(values, image, advance)
+        words = self._out_words(values, image, advance, checked)
         if words is None:
             raise PlcClientError("the output window cannot be filled from the last image")
         start, block = words
@@ -486,7 +488,7 @@ class TwinClient:
         start, block = self._out_words(values, image, 0)
         self._call(16, "write_registers", IMAGE_OUT + start, len(block), check_names(self.map, values), block)
 
-    def _out_words(self, values: Mapping[str, Any], image: "WindowImage", advance: int):
+    def _out_words(self, values: Mapping[str, Any], image: "WindowImage", advance: int, checked: bool = False):
         """(first word, words) of the output window covering `values` (and sim.advance), the words between
         them filled with the values `image` holds (so they are written unchanged)."""
         lay = self.layout
@@ -494,7 +496,7 @@ class TwinClient:
         for name, value in values.items():
             s = lookup(self.map, name)
             k, n = lay.out_words(s)
-            ws = [int(w) for w in encode(s, check_value(self.map, name, value))]
+            ws = [int(w) for w in encode(s, value if checked else check_value(self.map, name, value))]
             for i in range(n):
                 mine[k + i] = ws[i]
         if advance:
@@ -620,7 +622,7 @@ class ClientIO(LocalSignals):
         self.exchange = exchange and client.windows_fit
         self._image: WindowImage | None = None  # the input window as last read
         self._fresh = False  # it shows the process as it is now (lockstep: read after the last steps)
-        self._pending: dict[str, Any] = {}  # lockstep: outputs to write with the next advance
+        self._pending: dict[str, Any] = {}  # lockstep: outputs to write with the next advance (checked)
         self._reads: dict[tuple, list[Signal]] = {}  # the names a scan reads -> their entries (checked once)
 
     def _read(self, names: list[str]) -> dict[str, Any]:
@@ -642,13 +644,13 @@ class ClientIO(LocalSignals):
         if not self.exchange:
             self.client.write(values)
             return
-        for name, value in values.items():
-            check_value(self.client.map, name, value)  # refused here, at the scan that set it
+        checked = {name: check_value(self.client.map, name, value)  # refused here, at the scan that set it
+                   for name, value in values.items()}
         if ADVANCE in values or self._image is None:
             self.client.write(values)
             self._fresh = False
         elif self.lockstep:
-            self._pending.update(values)
+            self._pending.update(checked)
         else:
             self.client.write_window(values, self._image)
 
@@ -658,7 +660,7 @@ class ClientIO(LocalSignals):
         steps = max(0, target - self._steps)
         if self.exchange and self._image is not None and (steps or self._pending):
             pending, self._pending = self._pending, {}
-            self._image = self.client.exchange(pending, self._image, advance=steps)
+            self._image = self.client.exchange(pending, self._image, advance=steps, checked=True)
             self._fresh = True
             self._steps = target
             return

@@ -40,6 +40,7 @@ class TwinBridge:
         # changed (most do not from one step to the next) into them
         self._buffers = {t: bytearray(size if t in BIT_TABLES else 2 * size) for t, size in self._sizes.items()}
         self._last = {t: [_UNSET] * len(entries) for t, entries in self._keyed.items()}
+        self._bits = {t: [(e.address, key) for e, key in self._keyed[t]] for t in BIT_TABLES}
         self.images: Images = Images(b"", b"", b"", b"")
         self.publish(exchange.snapshot)
         self._unsubscribe = exchange.subscribe(on_snapshot=self.publish, on_writes=self._show_written)
@@ -115,8 +116,8 @@ class TwinBridge:
         for table, entries in self._keyed.items():
             buf, last = self._buffers[table], self._last[table]
             if table in BIT_TABLES:
-                for e, key in entries:
-                    buf[e.address] = 1 if get(key, 0) else 0
+                for address, key in self._bits[table]:
+                    buf[address] = 1 if get(key, 0) else 0
             else:
                 for i, (e, key) in enumerate(entries):
                     v = crc if key == MAP_CRC else get(key, 0)

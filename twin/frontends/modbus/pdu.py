@@ -343,14 +343,16 @@ class PduHandler:
             self.held_reads += 1
         return images
 
-    def _window(self, address: int, count: int):
+    def _window_fits(self, address: int, count: int) -> bool:
         lay = self.layout
         if address >= IMAGE_OUT:
-            start, size = address - IMAGE_OUT, lay.out_size
-        else:
-            start, size = address - IMAGE_IN, lay.in_size
-        if start + count > size:
+            return address - IMAGE_OUT + count <= lay.out_size
+        return address - IMAGE_IN + count <= lay.in_size
+
+    def _window(self, address: int, count: int):
+        if not self._window_fits(address, count):
             return ILLEGAL_DATA_ADDRESS
+        start = address - (IMAGE_OUT if address >= IMAGE_OUT else IMAGE_IN)
         if address >= IMAGE_OUT:
             images = self.backend.images
             window = b"".join(b"\x00" + bytes((b,)) for b in images.coils) + _patched(self.backend, images.holding)
@@ -500,7 +502,7 @@ class PduHandler:
             return ILLEGAL_DATA_VALUE
         if raddr < IMAGE_IN and not self.tables[HOLDING_REGISTER].readable(raddr, rcount):
             return ILLEGAL_DATA_ADDRESS
-        if raddr >= IMAGE_IN and isinstance(self._window(raddr, rcount), int):
+        if raddr >= IMAGE_IN and not self._window_fits(raddr, rcount):
             return ILLEGAL_DATA_ADDRESS
         # The spec's order: the write first, then the read (which sees the write).
         words = struct.unpack_from(f">{wcount}H", pdu, 10)

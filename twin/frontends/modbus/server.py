@@ -246,8 +246,12 @@ class ModbusServer:
 
     # -- the fair share ------------------------------------------------------------------------------
     def want_turn(self, conn: "_Connection", fresh: bool) -> None:
+        idle = self._scheduled is None and not self._fresh and not self._backlog
         (self._fresh if fresh else self._backlog).append(conn)
         conn.queued = True
+        if fresh and idle and conn.one_request():  # a client asking one thing at a time (a PLC's scan), and
+            self._serve()  # nobody else waiting: answered now, not a turn of the loop later
+            return
         loop = asyncio.get_running_loop()
         if self._scheduled is None:
             self._scheduled = loop.call_soon(self._serve)
@@ -462,6 +466,11 @@ class _Connection(asyncio.Protocol):
             return False
         _, pid, length, _ = _HDR.unpack_from(buf, 0)
         return pid != 0 or not 2 <= length <= MAX_LENGTH or len(buf) >= 6 + length
+
+    def one_request(self) -> bool:
+        """The buffer holds exactly one complete request."""
+        buf = self.buf
+        return len(buf) >= 7 and len(buf) == 6 + _HDR.unpack_from(buf, 0)[2]
 
     def answer(self, limit: int) -> int:
         """Answer up to `limit` complete requests at the front of the buffer; returns how many."""
