@@ -241,7 +241,7 @@ class TwinIO(LocalSignals):
 
     Values are published in the register map's engineering units (metres as mm) so the same logic runs
     here and over the network. `local`: signals the PLC holds itself (see `LocalSignals`). `wire`: a register
-    map (the one a server of this twin serves, `twin.modbus.register_map.RegisterMap`) whose resolution the
+    map (the one a server of this twin serves, `twin.frontends.modbus.register_map.RegisterMap`) whose resolution the
     values take both ways, encoded and decoded as on the wire: the logic reads and writes exactly what it
     would over Modbus, so the run is the same, bit for bit, as against `twin serve` (plain engineering values
     in full precision otherwise).

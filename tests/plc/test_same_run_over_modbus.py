@@ -11,7 +11,7 @@ from plc_client.client import ClientIO
 from plc_client.scan import Combined, ScanCycle, TwinIO
 from plc_client.testing import twin_server
 from stations.ring_rig_plc.demo import DEFAULT_STATION as STATION, ST_FILES, operator
-from twin.recording import Recording, record
+from twin.observe.recording import Recording, record
 from twin_app.cell import Cell
 
 
