@@ -1,6 +1,6 @@
 """Core benchmark: simulation steps per second, and how the grip check's cost grows with the target group.
 
-    python -m bench core [--steps N] [--against REV [--rounds N]]
+    python -m bench core [--steps N] [--targets 0,10,100,1000] [--no-motion] [--against REV [--rounds N]]
 
 Table 1: for every shipped station, the twin's step against the raw physics of the very same world (its
 `substeps` calls of pybullet's stepSimulation, nothing else), timed side by side in one run, alternating in
@@ -192,9 +192,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--against", metavar="REV", help="a git revision: its ring rig figures beside this tree's")
     parser.add_argument("--rounds", type=int, default=3, help="with --against: rounds of alternation (default 3)")
+    parser.add_argument("--targets", default="0,10,100,1000",
+                        help="extra targets beside the puck, one grip-check row each (default 0,10,100,1000)")
+    parser.add_argument("--no-motion", action="store_true", help="skip the ring rig in motion")
     args = parser.parse_args(argv)
     if args.against:
         return against(args.against, args.rounds, args.steps)
+    extras = [int(x) for x in args.targets.split(",") if x.strip()]
     print("The twin's step vs the raw physics of the same world (stepSimulation x substeps), headless, per step")
     print(f"{'station':<16}{'physics us':>12}{'twin us':>10}{'added us':>10}{'twin/physics':>14}{'physics x rt':>14}"
           f"{'twin x rt':>11}")
@@ -204,16 +208,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name:<16}{r['physics']:>12.0f}{r['twin']:>10.0f}{r['twin'] - r['physics']:>10.0f}"
               f"{r['twin'] / r['physics']:>14.2f}{rt / r['physics']:>14.1f}{rt / r['twin']:>11.1f}")
     print("(the cell at rest, as loaded: after 0.3 s at rest its loose bodies are frozen, twin/core/stasis.py)")
-    sim, wall, cpu, physics, physics_cpu = ring_rig_in_motion()
-    print(f"ring_rig in motion (pick and place, simulation API): {sim:.1f} s simulated in {wall:.2f} s wall, "
-          f"{sim / wall:.1f}x real time ({sim / cpu:.1f}x in CPU time); physics {physics:.2f} s of it (timed inside "
-          f"the twin's step), the twin adds {100 * (wall - physics) / physics:.0f} % "
-          f"({100 * (cpu - physics_cpu) / physics_cpu:.0f} % in CPU time)")
+    if not args.no_motion:
+        sim, wall, cpu, physics, physics_cpu = ring_rig_in_motion()
+        print(f"ring_rig in motion (pick and place, simulation API): {sim:.1f} s simulated in {wall:.2f} s wall, "
+              f"{sim / wall:.1f}x real time ({sim / cpu:.1f}x in CPU time); physics {physics:.2f} s of it (timed "
+              f"inside the twin's step), the twin adds {100 * (wall - physics) / physics:.0f} % "
+              f"({100 * (cpu - physics_cpu) / physics_cpu:.0f} % in CPU time)")
     print()
     print("Grip check cost per step vs size of the target group (four_finger holding its puck)")
     print(f"{'targets':>8}{'step us':>10}{'check us (ours)':>17}{'check us (naive)':>18}{'naive/ours':>12}")
-    for extra in (0, 10, 100, 1000):
-        cost = grip_check_costs(extra, max(20, args.steps // (1 + extra // 100)))
+    for extra in extras:
+        cost = grip_check_costs(extra, max(min(20, args.steps), args.steps // (1 + extra // 100)))
         print(f"{extra + 1:>8}{cost['step']:>10.0f}{cost['ours']:>17.1f}{cost['naive']:>18.1f}"
               f"{cost['naive'] / cost['ours']:>12.1f}")
     return 0

@@ -30,6 +30,10 @@ COUNT_UPDATES = """(seconds) => new Promise(resolve => {
 })"""
 
 
+WINDOWS = {"bare": lambda browser: (False, None), "record": lambda browser: (False, None, True),
+           "view": lambda browser: (True, browser, False), "view+record": lambda browser: (True, browser)}
+
+
 def realtime_run(seconds: float, view: bool, browser, record: bool | None = None) -> dict:
     from plc_client.testing import twin_server
 
@@ -82,10 +86,18 @@ def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench view", description=__doc__.split("\n\n")[0])
     parser.add_argument("--seconds", type=float, default=15.0, help="real-time window per run (default 15)")
     parser.add_argument("--steps", type=int, default=300, help="lockstep: steps per block (default 300)")
+    parser.add_argument("--no-browser", action="store_true", help="serve the page without opening it in Chromium")
+    parser.add_argument("--windows", default=",".join(WINDOWS),
+                        help=f"the real-time runs, of {', '.join(WINDOWS)} (default all)")
     args = parser.parse_args(argv)
+    windows = [w.strip() for w in args.windows.split(",") if w.strip()]
+    if not windows or any(w not in WINDOWS for w in windows):
+        parser.error(f"--windows: some of {', '.join(WINDOWS)}")
 
     browser, pw, why = None, None, ""
     try:
+        if args.no_browser:
+            raise ImportError("--no-browser")
         from playwright.sync_api import sync_playwright
 
         from tests.view.conftest import CHROMIUM_ARGS, chromium_path
@@ -99,10 +111,8 @@ def main(argv: list[str]) -> int:
     except ImportError as exc:
         why = f"no Playwright ({exc})"
     try:
-        runs = {"bare server": realtime_run(args.seconds, False, None),
-                "record": realtime_run(args.seconds, False, None, record=True),
-                "view": realtime_run(args.seconds, True, browser, record=False),
-                "view+record": realtime_run(args.seconds, True, browser)}
+        runs = {("bare server" if w == "bare" else w): realtime_run(args.seconds, *WINDOWS[w](browser))
+                for w in windows}
     finally:
         if browser is not None:
             browser.close()
