@@ -206,3 +206,34 @@ async def _lockstep(runner) -> None:
         await asyncio.sleep(0.001)
     runner.stop()
     await task
+
+
+def test_an_output_window_written_back_as_it_reads_changes_nothing_and_a_changed_word_writes():
+    """A PLC writes its whole output image every scan (OpenPLC does): the words it reads back are no write, so an
+    input another front end set finer than the map's 0.01 mm keeps its value; a word that differs is a write."""
+    from twin.frontends.modbus.pdu import IMAGE_OUT, PduHandler
+
+    twin = StandIn()
+    rmap = build_register_map(twin.signals, "stand-in")
+    exchange = Exchange(twin, log=lambda text: None)
+    bridge = TwinBridge(exchange, rmap)
+    pdus = PduHandler(rmap, bridge)
+    exchange.submit([("target", 0.0123456789)])  # e.g. through OPC UA, in full precision
+    exchange.step()
+    assert twin.read("target") == 0.0123456789
+    lay, hr = pdus.layout, rmap["target"]
+    window = struct.unpack(f">{lay.out_size}H", pdus.registers("holding_register", IMAGE_OUT, lay.out_size))
+    k = lay.out_words(hr)[0]
+    assert window[k:k + hr.count] == tuple(hr.encode(0.0123456789))  # 1234.57 counts of 0.01 mm, rounded
+    written = []
+    exchange.subscribe(on_writes=written.append)
+    request = struct.pack(f">BHHB{lay.out_size}H", 16, IMAGE_OUT, lay.out_size, 2 * lay.out_size, *window)
+    assert pdus.handle(request)[0] == 16
+    exchange.step()
+    assert written == [] and twin.read("target") == 0.0123456789  # not rounded to the map's resolution
+    changed = list(window)
+    changed[k:k + hr.count] = hr.encode(0.02)
+    assert pdus.handle(struct.pack(f">BHHB{lay.out_size}H", 16, IMAGE_OUT, lay.out_size, 2 * lay.out_size,
+                                   *changed))[0] == 16
+    exchange.step()
+    assert written == [[("target", 0.02)]] and twin.read("target") == 0.02
