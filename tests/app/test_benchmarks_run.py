@@ -20,7 +20,7 @@ TINY = {
     "cell": (["--rounds", "1", "--scans", "60"], "same run on both sides"),
     "campaign": (["--scenarios", "2", "--seconds", "0.3", "--no-cluster"], "results tables identical"),
     "rapid": (["--seconds", "0.2", "--no-planning"], "wall s per simulated s"),
-    "opcua": (["--requests", "10", "--changes", "3", "--items", "5", "--seconds", "0.5"], "monitored items"),
+    "opcua": (["--requests", "5", "--changes", "2", "--items", "5", "--seconds", "0.3"], "monitored items"),
     "view": (["--seconds", "0.5", "--steps", "20", "--no-browser", "--windows", "view+record"],
              "recording cost, us per step"),
     "map": (["--runs", "1"], "cell/static"),
