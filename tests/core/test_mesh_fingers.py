@@ -140,3 +140,33 @@ def test_a_placeholder_effort_no_drive_can_reach_is_named_in_one_warning_per_inp
             assert 0.0 < twin.read(f"{finger}.force") < 0.1 * 1000.0
     with Twin.from_station(STATION) as twin:
         assert twin.gripper.effort_notes == []  # 2 N m: reached 10 mrad past the peg
+
+
+def test_a_mesh_boxs_faces_collide_exactly_where_pybullets_own_hull_is_a_millimetre_short(tmp_path):
+    """A 20 mm box as an OBJ mesh (12 triangles) beside a box, 10, 1 and 0.2 mm apart and 0.3 mm into it: the
+    rewritten mesh (twin/core/meshes.py) reads the gap to within 0.01 mm; pybullet's own hull of the same file, with
+    the 1 mm margin it gives every hull (in a URDF link no setting reaches it), 1 mm short."""
+    from twin.core.meshes import surface_mesh
+
+    corners = [(x, y, z) for x in (-0.01, 0.01) for y in (-0.01, 0.01) for z in (-0.01, 0.01)]
+    quads = [(1, 2, 4, 3), (5, 7, 8, 6), (1, 5, 6, 2), (3, 4, 8, 7), (1, 3, 7, 5), (2, 6, 8, 4)]  # wound outwards
+    obj = tmp_path / "box.obj"
+    obj.write_text("".join("v %g %g %g\n" % v for v in corners)
+                   + "".join(f"f {a} {b} {c}\nf {a} {c} {d}\n" for a, b, c, d in quads))
+    rewritten = surface_mesh(obj, (1.0, 1.0, 1.0), tmp_path, "box")
+    c = pybullet.connect(pybullet.DIRECT)
+    try:
+        for path, short in ((rewritten, 0.0), (obj, 0.001)):
+            mesh = pybullet.createMultiBody(0, pybullet.createCollisionShape(pybullet.GEOM_MESH, fileName=str(path),
+                                                                             physicsClientId=c), physicsClientId=c)
+            for gap in (0.01, 0.001, 0.0002, -0.0003):
+                box = pybullet.createMultiBody(0, pybullet.createCollisionShape(
+                    pybullet.GEOM_BOX, halfExtents=[0.01] * 3, physicsClientId=c), basePosition=[0.02 + gap, 0, 0],
+                    physicsClientId=c)
+                pybullet.changeDynamics(box, -1, collisionMargin=0.0001, physicsClientId=c)
+                read = min(pt[8] for pt in pybullet.getClosestPoints(mesh, box, 0.05, physicsClientId=c))
+                assert read == pytest.approx(gap - short, abs=0.00001), (path.name, gap)
+                pybullet.removeBody(box, physicsClientId=c)
+            pybullet.removeBody(mesh, physicsClientId=c)
+    finally:
+        pybullet.disconnect(c)

@@ -7,18 +7,18 @@ touches a part 1 mm before its surface does, and where the mesh is concave (pybu
 40 mm notch and a 9 mm groove on its inner side) the hull fills what is not there: contacts 1 to 5 mm off the mesh.
 
 Instead, the world loads a rewritten mesh (an OBJ in its own folder, one object per piece; pybullet makes each
-object of an OBJ one convex hull): every triangle of the mesh becomes a thin convex prism under it, shrunk by the
-margin that pybullet then puts back round it. A prism's top lies `HULL_MARGIN` below its triangle, so the margin
-brings the surface exactly back to the triangle; its sides stand on the triangle's edges, pulled in by
-`HULL_MARGIN * tan(bend / 2)` where the surface bends away over that edge (so the rounded rim does not stand out
-of the next face), not at all where it runs on flat or bends up. The union of the rounded prisms is the mesh's
-surface (a sharp convex edge rounded by the margin, as pybullet rounds a box's: up to 0.41 mm at a right angle),
-`SHELL` deep. Meshes this cannot read (a format other than STL and OBJ, or triangles whose winding disagrees, so
-that no side is known to be outside) keep pybullet's hull; `prepared` tells which is which.
+object of an OBJ one convex hull): every triangle becomes a flat piece whose corners are the rounding centres of its
+vertices, each `HULL_MARGIN` under every face that meets that vertex (the least such move, solved per vertex; also
+across a T-junction, where a vertex lies on the next triangle's edge). pybullet's margin round the pieces then
+brings flat faces exactly back to the mesh and rounds its sharp edges and corners by the margin, as it rounds a box
+(a right-angled edge met 0.41 mm late, a corner of three right angles 0.73 mm), never early. Flaps of no volume
+(two triangles back to back over an edge) are left out. The pieces are 2 mm thick: a mesh wall thinner than that
+stands proud on its far side.
+Meshes this cannot read (a format other than STL and OBJ, more than MAX_PIECES triangles, or triangles whose
+winding disagrees, so that no side is known to be outside) keep pybullet's hull; `prepared` tells which is which.
 """
 from __future__ import annotations
 
-import math
 import struct
 from pathlib import Path
 
@@ -26,6 +26,7 @@ import numpy as np
 
 HULL_MARGIN = 0.001  # m: the margin pybullet puts round every convex hull it makes of a URDF mesh (fixed)
 WINDING_SLACK = 0.02  # a mesh whose windings disagree on more of its edges than this share is not rewritten
+MAX_PIECES = 5000  # a mesh of more triangles keeps pybullet's hull (a piece each: 2 ms a step for the PR2's 400 pieces)
 MAX_DEPTH = 3.0  # a vertex's rounding centre lies at most this many margins inside it (a knife edge)
 FOLD_COS = -0.9  # two triangles over one edge whose normals are further apart than this are a fold (left out)
 SUFFIX = ".surface.obj"  # the rewritten mesh's name ends so: `prepared` knows it
@@ -87,7 +88,10 @@ def _read_obj(text: str) -> tuple[np.ndarray, np.ndarray] | None:
 
 def surface_pieces(vertices: np.ndarray, faces: np.ndarray, margin: float = HULL_MARGIN) -> list[np.ndarray] | None:
     """The flat triangles (3 points each) whose union, each rounded by `margin`, is the mesh's surface (module
-    docstring). None when the triangles' winding disagrees (no side is known to be outside)."""
+    docstring). None when the triangles' winding disagrees (no side is known to be outside), or when there are more
+    than MAX_PIECES of them."""
+    if len(faces) > MAX_PIECES:
+        return None  # as many hulls would cost more physics than a finger is worth: pybullet's hull stays
     tri = vertices[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     area = np.linalg.norm(normal, axis=1)
@@ -118,7 +122,7 @@ def surface_pieces(vertices: np.ndarray, faces: np.ndarray, margin: float = HULL
     # each vertex's rounding centre: `margin` under every face that meets it (also across a T-junction: a face whose
     # edge it lies on), so the margin brings the faces back exactly and rounds edges and corners off by it, as
     # pybullet rounds a box's (contact at a right-angled edge 0.41 mm late, at a corner of three right angles 0.73 mm), never early
-    touching = _faces_at_vertices(vertices, tri)
+    touching = _faces_at_vertices(vertices, faces, tri)
     centre = np.empty_like(vertices)
     for v, fs in enumerate(touching):
         if not len(fs):  # on no triangle (a stray point): not part of any piece
@@ -135,13 +139,22 @@ def surface_pieces(vertices: np.ndarray, faces: np.ndarray, margin: float = HULL
     return [centre[ids] for ids in faces]
 
 
-def _faces_at_vertices(vertices: np.ndarray, tri: np.ndarray, tolerance: float = 1e-7) -> list[np.ndarray]:
-    """Per vertex, the triangles it lies on (a corner, or on an edge or face: a T-junction), within `tolerance`."""
-    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
-    out = []
-    for p in vertices:
-        out.append(np.nonzero(_point_triangle_distance(p, a, b, c) <= tolerance)[0])
-    return out
+def _faces_at_vertices(vertices: np.ndarray, faces: np.ndarray, tri: np.ndarray,
+                       tolerance: float = 1e-7) -> list[np.ndarray]:
+    """Per vertex, the triangles it lies on: those it is a corner of and, for a vertex on an open edge (a T-junction:
+    the next triangles' edge runs past it), those whose edge or face it lies on within `tolerance`."""
+    at: list[list[int]] = [[] for _ in range(len(vertices))]
+    edges: set[tuple[int, int]] = set()
+    for k, (a, b, c) in enumerate(faces):
+        at[a].append(k)
+        at[b].append(k)
+        at[c].append(k)
+        edges.update(((a, b), (b, c), (c, a)))
+    open_ends = {v for a, b in edges if (b, a) not in edges for v in (a, b)}
+    for v in sorted(open_ends):
+        near = np.nonzero(_point_triangle_distance(vertices[v], tri[:, 0], tri[:, 1], tri[:, 2]) <= tolerance)[0]
+        at[v] = sorted(set(at[v]) | set(near.tolist()))
+    return [np.asarray(fs, dtype=int) for fs in at]
 
 
 def _point_triangle_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
