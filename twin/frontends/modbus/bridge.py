@@ -13,7 +13,6 @@ can undo that.
 """
 from __future__ import annotations
 
-import dataclasses
 import struct
 from collections.abc import Sequence
 
@@ -99,14 +98,11 @@ class TwinBridge:
             elif entry.table == HOLDING_REGISTER:
                 if holding is None:
                     holding = bytearray(self.images.holding)
-                struct.pack_into(f">{entry.count}H", holding, 2 * entry.address, *entry.encode(value))
-        changed = {}
-        if coils is not None:
-            changed["coils"] = bytes(coils)
-        if holding is not None:
-            changed["holding"] = bytes(holding)
-        if changed:
-            self.images = dataclasses.replace(self.images, **changed)
+                entry.pack_into(holding, 2 * entry.address, value)
+        if coils is not None or holding is not None:
+            old = self.images
+            self.images = Images(old.coils if coils is None else bytes(coils), old.discrete_inputs,
+                                 old.holding if holding is None else bytes(holding), old.input_registers)
 
     def publish(self, snapshot: Snapshot | None = None) -> None:
         """New images from a snapshot (default: the exchange's latest), with the writes still queued on top."""

@@ -254,6 +254,8 @@ class PduHandler:
         self.refused_writes = 0
         self.held_reads = 0  # reads answered from a poll's first step while a later one was published
         self.hold: PollHold | None = None  # the connection being answered (set by `handle`)
+        adv = rmap.by_name.get(ADVANCE)
+        self._advance = adv if adv is not None and adv.table == HOLDING_REGISTER else None
         self._map_file: MapFile | None = None
 
     def handle(self, pdu: bytes, hold: PollHold | None = None) -> bytes:
@@ -278,7 +280,7 @@ class PduHandler:
     def clock_only(self, pdu: bytes) -> bool:
         """The request only reads or writes sim.advance (holding register 0): a lockstep harness driving
         and waiting for simulated time, not a controller's traffic (see twin.runtime.watchdog)."""
-        adv = self.map.by_name.get("sim.advance")
+        adv = self._advance
         if adv is None or len(pdu) < 5 or pdu[0] not in (3, 6, 16):
             return False
         address, second = _AQ.unpack_from(pdu, 1)
@@ -402,7 +404,7 @@ class PduHandler:
                 continue
             if k + e.count > end:
                 return ILLEGAL_DATA_ADDRESS
-            chunk = list(words[k - start:k - start + e.count])
+            chunk = tuple(words[k - start:k - start + e.count])
             if table == COIL:
                 if chunk[0] not in (0, 1):
                     return ILLEGAL_DATA_VALUE
@@ -410,7 +412,7 @@ class PduHandler:
             else:
                 if current_h is None:
                     current_h = _patched(self.backend, images.holding)
-                same = list(struct.unpack_from(f">{e.count}H", current_h, 2 * a)) == chunk
+                same = current_h[2 * a:2 * a + 2 * e.count] == struct.pack(f">{e.count}H", *chunk)
             if not e.writable:
                 if not same:
                     return ILLEGAL_DATA_ADDRESS
@@ -520,8 +522,8 @@ class PduHandler:
 
     def _advances(self, address: int, words: Sequence[int]) -> bool:
         """The write sets sim.advance to a number of steps (directly, or through the output window)."""
-        adv = self.map.by_name.get(ADVANCE)
-        if adv is None or adv.table != HOLDING_REGISTER:
+        adv = self._advance
+        if adv is None:
             return False
         at = adv.address if address < IMAGE_OUT else IMAGE_OUT + self.layout.out_offset[HOLDING_REGISTER] + adv.address
         return address <= at < address + len(words) and words[at - address] != 0

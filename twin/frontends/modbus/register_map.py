@@ -144,7 +144,7 @@ class Entry:
         return REFERENCE_BASE[self.table] + self.address
 
     # -- counts ---------------------------------------------------------------------------------------
-    @property
+    @cached_property
     def count_range(self) -> tuple[float, float]:
         """The counts a write may carry (inclusive); floats for float32."""
         if self.type == "bool":
