@@ -150,7 +150,9 @@ def report(cycles: int, kind: str, local: list[dict], remote: list[dict]) -> str
         ratio = f"{b / a:.2f}" if a else ""
         print(f"{name:34}{f.format(a):>12}{f.format(b):>13}{ratio:>8}")
     print("  wall s per run: in process " + " ".join(f"{r['wall']:.3f}" for r in local)
-          + "; over Modbus " + " ".join(f"{r['wall']:.3f}" for r in remote))
+          + "; over Modbus " + " ".join(f"{r['wall']:.3f}" for r in remote)
+          + f" (fastest runs: {min(r['wall'] for r in remote) / min(r['wall'] for r in local):.2f}x; a loaded machine "
+          "only adds time)")
     same = {(r["scans"], r["steps"], r["pose"]) for r in local + remote}
     if len(same) == 1:
         scans, steps, pose = same.pop()
