@@ -20,8 +20,10 @@ moves, m (its links, its mimic followers', and the lightest target when it carri
 their inertia and the target at the finger's reach), shared by the n fingers' own drives: K <= m / (n h^2) (below
 that the spring is stable), D = m_own / (n h) (its own links alone: a part resting on a fixture does not move with
 them). Drives in series on a pressed finger (a fine axis on its carriage) take out m_own / m of their error per
-substep: the part holds their sum, and only their own links move between them. A station's stiffness above that limit makes its drive rigid up to its
-effort. A free finger follows its command with almost no force; a finger stopped by a part presses with K times how
+substep: the part holds their sum, and only their own links move between them; one pressing on through others that
+stand at their goals presses with at most SERIES_HOLD of what they hold (the finger's force passes through each), so
+they keep their goals instead of trading places with it at equal limits. A station's stiffness above that limit makes
+its drive rigid up to its effort. A free finger follows its command with almost no force; a finger stopped by a part presses with K times how
 far its setpoint lies past it, up to the effort. What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
 target objects (averaged over the substeps; a revolute finger's is the torque about its joint of those contacts' force, friction included),
@@ -75,6 +77,9 @@ FORCE_RISE_TIME = 0.05  # s: a drive whose finger presses on a part runs its com
 # grippers), or its whole period, lets two 40 N fingers on a 300 g steel cylinder rock it (status 0 again 15 to 41
 # steps after touching); 50 ms (4 steps) holds every test gripper. The station's `[gripper] force_rise_time` overrides it
 FOLLOW_FRACTION = 0.965  # ... once the error has fallen below this share (both springs of a squeezed pair hold it)
+SERIES_HOLD = 1.0 - (1.0 - LATCH_FRACTION - HOLD_FRACTION) / 2  # a drive pressing through drives in series that
+# stand at their goals presses with at most this share of what they hold (99.75 %): above a stalled finger's 99.5 %, so
+# it presses like the other fingers and resists a push, and short of the one that holds, so that one keeps its goal
 RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
 HELD_SHARE = 0.5  # a joint that moved less than this share of its velocity limit the drive's way (over the last
 # substep) is held: only then does its command run on to build force, and may it ask for more than its limit's speed
@@ -211,6 +216,7 @@ class Gripper:
         for joint, master, mult, off in self.mimics:
             client.resetJointState(body, joint, mult * self.setpoint[master] + off)
         self.closing = self._closing_directions()
+        self._series_loads = self._series_couplings()
         for joint, master, mult, off in self.mimics:
             self._couple(joint, master, mult, off)
         self._mesh_links: set[int] = set()
@@ -386,6 +392,41 @@ class Gripper:
                     reach = max(reach, abs(mult) * off_axis(corner))
         return inertia, reach
 
+    def _series_couplings(self) -> dict[str, tuple[tuple[str, float], ...]]:
+        """Per input, the other drives in series with it on a finger (a fine axis and the carriage it rides on) that
+        a force it presses with loads, and how much: a finger pushed along its drive's motion with the drive's force
+        (generalised force E over the finger's motion per unit of the drive's, |J_p|) loads another drive in its
+        chain with E (J_s . J_p) / |J_p|^2 (the two drives' linear Jacobians at the finger, mimic followers counted
+        with their multipliers), in the station's initial pose: a fine axis collinear with its carriage carries all
+        of the carriage's force, a lift across the closing direction none."""
+        c, body = self.client, self.body
+        movable = [j for j in range(c.getNumJoints(body)) if c.getJointInfo(body, j)[2] != pybullet.JOINT_FIXED]
+        column = {j: i for i, j in enumerate(movable)}
+        q = [c.getJointState(body, j)[0] for j in movable]
+        zero = [0.0] * len(movable)
+        weights: dict[str, dict[int, float]] = {name: {self.joint[name]: 1.0} for name in self.names}
+        for joint, master, mult, _ in self.mimics:
+            weights[master][joint] = mult
+        loads: dict[str, dict[str, float]] = {}
+        for finger, servos in self.finger_servos.items():
+            if len(servos) < 2:
+                continue
+            chain = self._chain(self.finger_joint[finger])
+            linear = c.calculateJacobian(body, self.finger_joint[finger], [0.0, 0.0, 0.0], q, zero, zero)[0]
+            cols = {}
+            for name in servos:
+                cols[name] = [sum(w * linear[axis][column[j]] for j, w in weights[name].items() if j in chain)
+                              for axis in range(3)]
+            for p in servos:
+                norm = sum(v * v for v in cols[p])
+                for s in servos:
+                    if s == p or norm == 0.0:
+                        continue
+                    share = abs(sum(a * b for a, b in zip(cols[s], cols[p]))) / norm
+                    if share > 1e-6:
+                        loads.setdefault(p, {})[s] = max(share, loads.get(p, {}).get(s, 0.0))
+        return {p: tuple(sorted(ss.items())) for p, ss in loads.items()}
+
     def _chain(self, joint: int) -> list[int]:
         """`joint` and the joints between it and the body's base, nearest first."""
         chain = []
@@ -482,6 +523,7 @@ class Gripper:
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
         axes, presses, series = self.state.axes, self._presses, self._series  # as the last step left them
+        loads = self._series_loads
         for (name, _, moving), (actual, joint_speed, _, _), moved in zip(self._per_input, states, self._speeds):
             d = drives[name]
             g = goal[name]
@@ -538,10 +580,18 @@ class Gripper:
                 # a held joint asks for more (the solver builds the force against the part from that speed)
                 speed = d.velocity if speed > 0.0 else -d.velocity
             velocities.append(speed)
+            effort = d.effort
+            if pressing and name in loads and target != g:
+                # pressing through drives in series that stand at their goals (a carriage through its fine axis):
+                # never harder than they hold, less a reserve, or the one that holds is pushed off its goal at its
+                # limit and the pair trade places, the finger standing (status 0, `moving`, while it presses)
+                for other, share in loads[name]:
+                    if command[other] == goal[other]:
+                        effort = min(effort, SERIES_HOLD * drives[other].effort / share)
             if d.stiffness > d.limit:  # stiffer than the step resolves (a station's choice): rigid up to its effort
-                forces.append(d.effort)
+                forces.append(effort)
             else:
-                forces.append(min(d.effort, abs(d.stiffness * error - d.damping * joint_speed) + HOLD_FRACTION * d.effort))
+                forces.append(min(effort, abs(d.stiffness * error - d.damping * joint_speed) + HOLD_FRACTION * d.effort))
             quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
                      and d.stiffness * abs(error) <= HOLD_FRACTION * d.effort)  # a pressing drive: every substep
         self._quiet = quiet
