@@ -695,3 +695,83 @@ def test_every_shipped_station_passes_its_check(tmp_path, capsys, folder):
     code, text, report = run_check(folder, tmp_path, capsys)
     assert any(not g["skipped"] for g in report["grips"]), text  # it gripped something: no vacuous PASS
     assert code == 0 and not lines(text, "FAIL"), text
+
+
+# -- a finger on two drives in series, of our own making ------------------------------------------------------------
+def series_station(folder, slide: float, fine: float, fine_stiffness: float | None = None):
+    """The newcomer's gripper with jaw_b on a carriage (slide_b, no collision shape: no finger) and a fine axis on
+    it (fine_b, the finger), both along the closing line, as a ring rig's finger 3; jaw_a 40 N on its own drive.
+    Each inner face at y = +-q: jaw_a's q its joint, jaw_b's the carriage's plus the fine axis's."""
+    t, w, length = FINGER
+    folder.mkdir()
+    box = f'<box size="{w} {t} {length}"/>'
+    inertial = '<inertial><origin xyz="0 {y} {z}"/><mass value="{m}"/><inertia ixx="1.2e-5" ixy="0" ixz="0" ' \
+               'iyy="1.1e-5" iyz="0" izz="2.1e-6"/></inertial>'
+    (folder / "gripper.urdf").write_text(f"""<?xml version="1.0"?>
+<robot name="series">
+  <link name="palm">
+    <inertial><origin xyz="0 0 -0.01"/><mass value="0.3"/><inertia ixx="2.6e-4" ixy="0" ixz="0" iyy="2.6e-4" iyz="0" izz="5e-4"/></inertial>
+    <collision><origin xyz="0 0 -0.01"/><geometry><box size="0.1 0.1 0.02"/></geometry></collision>
+  </link>
+  <joint name="jaw_a_joint" type="prismatic">
+    <parent link="palm"/><child link="jaw_a"/><axis xyz="0 1 0"/>
+    <limit lower="0" upper="0.04" velocity="0.05" effort="40"/>
+  </joint>
+  <link name="jaw_a">{inertial.format(y=t / 2, z=length / 2, m=0.05)}
+    <collision><origin xyz="0 {t / 2} {length / 2}"/><geometry>{box}</geometry></collision>
+  </link>
+  <joint name="slide_b_joint" type="prismatic">
+    <parent link="palm"/><child link="slide_b"/><axis xyz="0 -1 0"/>
+    <limit lower="0" upper="0.04" velocity="0.05" effort="{slide}"/>
+  </joint>
+  <link name="slide_b">{inertial.format(y=0, z=0.005, m=0.05)}</link>
+  <joint name="fine_b_joint" type="prismatic">
+    <parent link="slide_b"/><child link="fine_b"/><axis xyz="0 -1 0"/>
+    <limit lower="-0.005" upper="0.005" velocity="0.05" effort="{fine}"/>
+  </joint>
+  <link name="fine_b">{inertial.format(y=-t / 2, z=length / 2, m=0.05)}
+    <collision><origin xyz="0 {-t / 2} {length / 2}"/><geometry>{box}</geometry></collision>
+  </link>
+</robot>
+""")
+    sx, sy, sz = BLOCK
+    stiff = "" if fine_stiffness is None else f"[gripper.joints.fine_b]\nstiffness = {fine_stiffness}\n"
+    (folder / "station.toml").write_text(f"""[station]
+name = "series"
+
+[gripper]
+urdf = "gripper.urdf"
+mount = {{ xyz = [0.0, 0.0, {sz + 0.015}], rpy_deg = [180.0, 0.0, 0.0] }}
+always_active = true
+friction = {FINGER_FRICTION}
+initial = {{ jaw_a = 0.035, slide_b = 0.035, fine_b = 0.0 }}
+{stiff}
+[[targets]]
+name = "block"
+shape = "box"
+size = [{sx}, {sy}, {sz}]
+xyz = [0.0, 0.0, {sz / 2}]
+density = {DENSITY}
+friction = {PART_FRICTION}
+
+[[fixtures]]
+name = "floor"
+shape = "plane"
+""")
+    return folder
+
+
+def test_a_finger_closed_by_its_carriage_through_a_stiff_fine_axis_stalls_steady_with_its_effort(tmp_path, capsys):
+    """The ring rig's finger 3 on a light gripper of our own: 40 N jaw_a against a finger whose 40 N carriage closes
+    it through a 40 N fine axis stiffer than the step resolves (rigid up to its effort). Its force passes through
+    both drives, so by statics it presses with their common effort; it stalls like any finger: a steady status 2,
+    nothing `moving`, within 0.05 mm, the block staying put (the carriage presses with at most 99.75 % of what the
+    fine axis holds: at equal limits the pair traded places on the ring rig)."""
+    slide, fine = 40.0, 40.0
+    folder = series_station(tmp_path / "st", slide, fine, 1e6)
+    code, text, report = run_check(folder, tmp_path, capsys)
+    assert code == 0 and not lines(text, "FAIL"), text
+    forces = {f["finger"]: f["force"] for f in grip(report, "block", "outside")["fingers"]}
+    # within 2 % (docs/station-format.md, "Drives"): the carriage's cap costs the finger no noticeable force
+    assert forces["jaw_a"] == pytest.approx(40.0, rel=0.02), forces
+    assert forces["fine_b"] == pytest.approx(min(slide, fine), rel=0.02), forces
