@@ -324,15 +324,21 @@ class Gripper:
             moved[name] = links
         carriers = {name for name in self.names if finger_links & {k for k, _ in moved[name]}}
         share = max(1, len({servos[0] for servos in self.finger_servos.values() if servos}))  # the fingers' own drives
+        self.finger_forces: dict[str, float] = {}  # N: what each finger-carrying drive presses a finger with, at most
         for name in self.names:
             d, links = self.drives[name], moved[name]
             fingers = name in carriers
+            jaws = sum(abs(m) for k, m in links if k in finger_links) or 1.0  # a linkage shares its effort out
             if self.unit[name] == "m":
                 own = sum(mult * mult * c.getDynamicsInfo(body, k)[0] for k, mult in links)
                 mass, floor = own + (part if fingers else 0.0), 1e-3
+                if fingers:
+                    self.finger_forces[name] = d.effort / jaws
             else:
                 own, reach = self._inertia_about_axis(name, links, finger_links)
                 mass, floor = own + (part * reach * reach if fingers else 0.0), 1e-7
+                if fingers and reach > 0.0:
+                    self.finger_forces[name] = d.effort / reach / jaws  # at the fingers' reach
             mass, own = max(mass, floor), max(own, floor)
             limit = STIFFNESS_SHARE * mass / (share * h * h)
             stiffness = stiffness_given[name] or min(d.effort / FULL_FORCE_ERROR[self.unit[name]], limit)

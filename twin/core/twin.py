@@ -67,6 +67,8 @@ class Twin:
         self.gripper = Gripper(self.world.client, self.world.machine, self.world.joint_index, self.world.link_index,
                                self.mechanism, st.gripper, {t.name: self.world.body_ids[t.name] for t in st.targets},
                                self.world.substep, self.world.contact_probe, self.world.substeps)
+        if self.gripper.finger_forces:
+            self.world.squeeze_tolerance_within(min(self.gripper.finger_forces.values()))
         self.robot = None
         if st.robot is not None:
             from .geometry import Pose

@@ -359,7 +359,8 @@ class World:
                                     deterministicOverlappingPairs=1)
         tolerance = solver_tolerance(st, self.substep)
         # (the solver's measure is the largest squared change of an impulse in a sweep)
-        self._residuals = (PYBULLET_RESIDUAL, PYBULLET_RESIDUAL if tolerance is None else tolerance ** 2)
+        self._residuals = (PYBULLET_RESIDUAL, PYBULLET_RESIDUAL if tolerance is None
+                           else max(PYBULLET_RESIDUAL, tolerance ** 2))  # never finer than pybullet's own
         self._pressing = False
         c.setPhysicsEngineParameter(solverResidualThreshold=PYBULLET_RESIDUAL)
 
@@ -374,6 +375,13 @@ class World:
         self.probe = ContactProbe(self.client, self.machine, finger_links, targets,
                                   lambda client, name: create_body(client, spec[name]))
         return self.probe
+
+    def squeeze_tolerance_within(self, force: float) -> None:
+        """Keep the squeeze's tolerance within RESIDUAL_SHARE of `force` (N, the weakest finger's) over a substep too:
+        a weak drive on a heavy part is solved as finely as its own force needs."""
+        if force > 0.0:
+            finest = max(PYBULLET_RESIDUAL, (RESIDUAL_SHARE * force * self.substep) ** 2)
+            self._residuals = (PYBULLET_RESIDUAL, min(self._residuals[1], finest))
 
     def solve_for(self, pressing: bool) -> None:
         """The solver's tolerance for the next step: `solver_tolerance` while fingers press on a part (a squeeze's
