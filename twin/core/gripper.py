@@ -184,6 +184,7 @@ class Gripper:
         self.palm_link = common[0] if common else self.base_link
         self._fingers_of_servo = {name: [f for f, servos in self.finger_servos.items() if name in servos]
                                   for name in self.names}
+        self._pressing_none = {name: False for name in self.names}  # (read only: no drive's finger presses)
         self._derive_drives(stiffness_given)
         self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
         self.effort_notes = self._unreachable_efforts()
@@ -680,10 +681,17 @@ class Gripper:
             lo, hi = self._range[name]  # the joint's stop: the solver's give at a stop is no position the joint has
             axes[name] = AxisState(min(max(q, lo), hi), (q - last[i]) / dt, self._effort_sum[i] / n if self._n else 0.0)
         self.state.axes = axes
+        friction = self.spec.grip == "friction"
+        if friction and not self._force_sum:  # no finger pressed on anything in this step: none touches (no query)
+            self.state.fingers = {f: FingerState((), 0, {}, self._status(f, axes, False))  # (0: an empty sum)
+                                 for f in self.finger_links}
+            self._presses, self.pressing = self._pressing_none, False
+            self._reset_sums()
+            self._grip_rule()
+            return
         pressing: dict[str, dict[str, float]] = {}
         for (finger, uid), total in self._force_sum.items():
             pressing.setdefault(finger, {})[self._target_by_id[uid]] = total / n
-        friction = self.spec.grip == "friction"
         fingers = {}
         for finger in self.finger_links:
             pressed = pressing.get(finger)
@@ -700,7 +708,10 @@ class Gripper:
         self._presses = {name: any(fingers[f].force > 0.0 for f in fs) for name, fs in self._fingers_of_servo.items()}
         self.pressing = any(f.force > 0.0 for f in fingers.values())  # a finger pressed on a part in this step
         self._reset_sums()
+        self._grip_rule()
 
+    def _grip_rule(self) -> None:
+        """Grip, attachment and slip from the fingers' contacts and forces of the step just sensed."""
         held = self.state.gripped
         if held and self._pressed_by_all(self._release_force, held):
             gripped = [held]  # hysteresis: a grip lasts while every finger presses with a quarter of the grip force
