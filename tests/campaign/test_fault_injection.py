@@ -95,8 +95,10 @@ def test_a_finger_that_loses_force_does_not_squeeze(bench):
             twin.step(150)
         _, full = healthy.drive_limits("L3")
         assert healthy.read("L3.force") == pytest.approx(full, rel=0.05)
-        # signals: its force stays at the lost drive's (pushed back by the ring, it balances it with its motor's 20 N:
-        # the contact force reads that within the solver's 0.1 %, not the 1500 N the other drives press with)
+        # signals: its force stays at the lost drive's (pushed back by the ring, it balances it with its motor's 20 N,
+        # not the 1500 N the other drives press with). The contact force, averaged over the step's substeps, jitters
+        # about the 20 N as the finger rocks against the ring: within 0.05 % from step 100 on (0.17 % when the drive
+        # was first held to its velocity limit), so 0.5 % above the motor's limit is all a reading may show
         assert bench.read("L3.force") <= 20.0 * 1.005
         assert bench.read("L3.force") == pytest.approx(20.0, rel=0.1)
         assert bench.drive_limits("L3")[1] == 20.0  # physics: the motor pushes with 20 N at most
