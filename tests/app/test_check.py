@@ -775,3 +775,26 @@ def test_a_finger_closed_by_its_carriage_through_a_stiff_fine_axis_stalls_steady
     # within 2 % (docs/station-format.md, "Drives"): the carriage's cap costs the finger no noticeable force
     assert forces["jaw_a"] == pytest.approx(40.0, rel=0.02), forces
     assert forces["fine_b"] == pytest.approx(min(slide, fine), rel=0.02), forces
+
+
+def test_a_station_on_which_no_grip_can_be_tried_fails_instead_of_passing(tmp_path, capsys):
+    """tri_120_60n with its fingers' inner faces started 0.1 mm inside the can (its radius from the station file):
+    no grip can start, nothing is measured, so the station is not shown ready: exit 1, not a PASS."""
+    import shutil
+
+    folder = tmp_path / "tri"
+    from tests.core.outsider_grippers import GRIPPERS
+
+    shutil.copytree(GRIPPERS / "tri_120_60n", folder)
+    toml = folder / "station.toml"
+    radius = tomllib.loads(toml.read_text())["targets"][0]["radius"]
+    q = radius - 1e-4
+    text = toml.read_text().replace("initial = { f1 = 0.05, f2 = 0.05, f3 = 0.05 }",
+                                    f"initial = {{ f1 = {q}, f2 = {q}, f3 = {q} }}")
+    assert f"f1 = {q}" in text
+    toml.write_text(text)
+    code, out, report = run_check(folder, tmp_path, capsys)
+    assert code == 1, out
+    assert report["verdict"] == "FAIL"
+    assert all(g["skipped"] for g in report["grips"]), out
+    consistent_exit(code, out)

@@ -529,6 +529,10 @@ class Doctor:
                     result.skipped = result.skipped or "the robot cannot get there"
                     self.check(FAIL, f"{body.name} {mode}", "robot", "motion", str(exc))
                     return self.report
+        if all(g.skipped for g in self.report.grips) and not self.report.failed:
+            # nothing was gripped, so nothing is known: a station the doctor could not try is not ready
+            why = "; ".join(dict.fromkeys(f"{g.target} {g.mode}: {g.skipped}" for g in self.report.grips))
+            self.check(FAIL, "station", "grip", "tried", f"no grip could be tried on any target ({why})")
         return self.report
 
     def densities(self) -> None:
