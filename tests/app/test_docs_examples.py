@@ -3,7 +3,9 @@ twin/frontends/modbus/README.md runs here, as a reader would run it (from the pr
 
 An example that cannot run here says so visibly, in its first line: a comment starting `# illustrative:`
 and why (it starts a server on a fixed port, needs a cluster or a real PLC, runs the whole suite, takes
-minutes, or shows a command's synopsis). Everything else runs:
+minutes, or shows a command's synopsis). The README's opening block is the exception: it holds exactly the two
+set-up commands (`python3 tasks.py demo`, `python3 tasks.py test`), checked below for what they are; CI runs the
+second and tests/plc/test_demo_cli.py the first. Everything else runs:
 
 - a Python example with `def test_...` functions is a pytest file (as the reader would save it), run by
   pytest with `plc_client.testing`'s fixtures; a comment `# plc_station: PATH` in it names the station its
@@ -30,10 +32,16 @@ RUN = ("sh", "python")
 ILLUSTRATIVE = "# illustrative:"
 
 
+FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.S | re.M)
+SETUP = ["python3 tasks.py demo", "python3 tasks.py test"]
+
+
 def examples():
     for path in DOCS:
         text = path.read_text(encoding="utf-8")
-        for m in re.finditer(r"^```(\w*)\n(.*?)^```", text, re.S | re.M):
+        for i, m in enumerate(FENCE.finditer(text)):
+            if path.name == "README.md" and path.parent == ROOT and i == 0:
+                continue  # the two set-up commands (test_the_readme_opens_with_the_two_setup_commands)
             if m.group(1) in RUN:
                 line = text[:m.start()].count("\n") + 2
                 yield pytest.param(m.group(1), m.group(2), id=f"{path.relative_to(ROOT)}:{line}")
@@ -46,6 +54,15 @@ def test_the_examples_are_found_and_most_python_ones_run():
     assert len(ALL) >= 20
     python = [p for p in ALL if p.values[0] == "python"]
     assert sum(not p.values[1].startswith(ILLUSTRATIVE) for p in python) >= len(python) - 2
+
+
+def test_the_readme_opens_with_the_two_setup_commands():
+    """The README's first code block: the demo, then the tests, and nothing else (comments aside)."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    first = FENCE.search(text)
+    assert text[:first.start()].strip().startswith("# ") and text[:first.start()].count("\n") <= 3
+    commands = [ln.split("#")[0].strip() for ln in first.group(2).splitlines()]
+    assert [c for c in commands if c] == SETUP
 
 
 def env() -> dict:
