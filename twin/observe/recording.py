@@ -331,7 +331,7 @@ class Recorder(ObservingDevice):
         microsecond per row, where encoding them here would cost ten to twenty)."""
         rows, self._group = self._group, _Group(self.layout, self._capacity)
         if rows.n:
-            self._writer.send(("group", rows.steps, rows.times, rows.values, rows.poses, rows.joints))
+            self._writer.send_group(("group", rows.steps, rows.times, rows.values, rows.poses, rows.joints))
 
     def close(self) -> None:
         """Write what is buffered and finish the file (a Parquet file: the stream becomes Parquet); returns
@@ -392,6 +392,7 @@ class _WriterProcess:
         finally:
             for end in (read, fd, told):
                 os.close(end)
+        self._acks, self._in_flight = ready, 0  # the writer says b"w" for each group it has written
         try:
             self.send(("scene", scene.as_dict()))
             self._wait_ready(ready)
@@ -399,9 +400,8 @@ class _WriterProcess:
             self.process.kill()
             self.process.wait()
             os.close(self._pipe)
-            raise
-        finally:
             os.close(ready)
+            raise
 
     def _wait_ready(self, ready: int) -> None:
         """Wait (before the first step) until it has set itself up: from then on it writes a group within
@@ -411,6 +411,24 @@ class _WriterProcess:
         if not select.select([ready], [], [], START_TIMEOUT)[0] or os.read(ready, 1) != b"r":
             raise RecordingError(f"{self.path}: the recorder's process did not start (exit status "
                                  f"{self.process.poll()}); see the message it left on stderr")
+
+    def send_group(self, message: tuple) -> None:
+        """Hand a group over once the one before it is on disk: at most one group is ever in flight, so a
+        crash loses at most that one and the group being filled, whatever the load (a writer that has fallen
+        behind makes the step wait instead of the file falling further behind)."""
+        import select
+
+        while self._in_flight:
+            if not select.select([self._acks], [], [], START_TIMEOUT)[0]:
+                raise RecordingError(f"{self.path}: the recorder's process has not written a group for "
+                                     f"{START_TIMEOUT} s (exit status {self.process.poll()})")
+            got = os.read(self._acks, 64)
+            if not got:
+                raise RecordingError(f"{self.path}: the recorder's process stopped (exit status "
+                                     f"{self.process.poll()}); see the message it left on stderr")
+            self._in_flight -= len(got)
+        self.send(message)
+        self._in_flight += 1
 
     def send(self, message: tuple) -> None:
         try:
@@ -426,6 +444,7 @@ class _WriterProcess:
         finally:
             os.close(self._pipe)
             status = self.process.wait()
+            os.close(self._acks)
         if status != 0:
             raise RecordingError(f"{self.path}: the recorder's process failed (exit status {status}); "
                                  "see the message it left on stderr")
@@ -478,12 +497,15 @@ def _writer_main() -> None:
             if message[0] == "scene":
                 writer = _FileWriter(fd, path, Scene.from_dict(message[1]))
                 os.write(told, b"r")
-                os.close(told)
             elif message[0] == "group":
                 rows = _Group(writer.layout, len(message[1]))
                 rows.steps, rows.times, rows.values, rows.poses, rows.joints = message[1:]
                 rows.n = len(rows.steps)
                 writer.write(rows)
+                try:
+                    os.write(told, b"w")  # on disk: the simulation may hand over the next group
+                except OSError:  # the simulation's process is gone: write on what it sent
+                    pass
             elif message[0] == "close":
                 closing = True
                 break
