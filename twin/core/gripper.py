@@ -94,7 +94,7 @@ _warned_efforts: set[str] = set()  # each unreachable effort warned of once per 
 STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
 
 
-@dataclass
+@dataclass(slots=True)
 class AxisState:
     actual: float = 0.0
     velocity: float = 0.0
@@ -244,6 +244,9 @@ class Gripper:
         self._ticks = 0  # physics substeps since the joints were last read
         self._sent: tuple | None = None
         self._per_input = [(name, self.unit[name], MOVING_SPEED[self.unit[name]]) for name in self.names]
+        self._ranges = [(name, *self._range[name]) for name in self.names]
+        self.read_along([])
+        self._idle_statuses: list[int] | None = None  # the fingers' statuses while their states are of touching nothing
         self._joint_axis = {f: client.getJointInfo(body, j)[13] for f, j in self.finger_joint.items()}
         self._joint_frames: dict[str, tuple] = {}  # revolute fingers' joint frames, this substep
         self.state = GripState()
@@ -610,6 +613,19 @@ class Gripper:
                          forces=forces)
             self._sent = sent
 
+    def read_along(self, joints: list[int]) -> None:
+        """Read `joints` (of the same body) with the inputs' joints after each step's last substep, into `along`
+        (one pybullet call where the twin would make two)."""
+        self._along_ids = self._joint_ids + list(joints) if joints else []
+        self._along_from = len(self._joint_ids)
+        self.along = ()
+
+    def coast(self, substeps: int) -> None:
+        """`substeps` physics substeps run while every drive stands quiet (`quiet`): they keep the step's first
+        substep's settings and nothing is measured before the last (`drive` and `measure` would do nothing else)."""
+        self._step_ticks += substeps
+        self._ticks += substeps
+
     @property
     def step_positions(self) -> list[float] | None:
         """The input joints' positions (`joint_ids`' order) as read after the last step's last substep."""
@@ -631,7 +647,12 @@ class Gripper:
             return
         self._n += 1
         before = self._states
-        states = self._states = self._joint_states(self.body, self._joint_ids)
+        if last and self._along_ids:
+            states = self._joint_states(self.body, self._along_ids)
+            self.along, states = states[self._along_from:], states[:self._along_from]
+        else:
+            states = self._joint_states(self.body, self._joint_ids)
+        self._states = states
         if before is not None:  # how fast each joint ran, from its positions (pybullet's joint velocity reads the
             # motor's target where a contact holds the joint back): whether a part holds it (`drive`)
             elapsed = self._ticks * self.h
@@ -669,26 +690,34 @@ class Gripper:
     # -- after each step --------------------------------------------------------------------------------------
     def sense(self) -> None:
         """Read joints, efforts and contacts after physics; decide grip, attachment, slip and status."""
-        n = max(1, self._n)
-        if not self._n:  # no substep measured since the last sense (a new gripper): read the joints now
+        measured = self._n
+        n = max(1, measured)
+        if not measured:  # no substep measured since the last sense (a new gripper): read the joints now
             self._states = self._joint_states(self.body, self._joint_ids)
         positions = [s[0] for s in self._states]
         last = self._step_positions or positions
         dt = max(1, self._step_ticks) * self.h
         self._step_positions, self._step_ticks = positions, 0
         axes = {}
-        for i, (name, q) in enumerate(zip(self.names, positions)):
-            lo, hi = self._range[name]  # the joint's stop: the solver's give at a stop is no position the joint has
-            axes[name] = AxisState(min(max(q, lo), hi), (q - last[i]) / dt, self._effort_sum[i] / n if self._n else 0.0)
+        # (lo, hi: the joint's stop: the solver's give at a stop is no position the joint has)
+        for (name, lo, hi), q, before, effort in zip(self._ranges, positions, last, self._effort_sum):
+            axes[name] = AxisState(min(max(q, lo), hi), (q - before) / dt, effort / n if measured else 0.0)
         self.state.axes = axes
         friction = self.spec.grip == "friction"
         if friction and not self._force_sum:  # no finger pressed on anything in this step: none touches (no query)
-            self.state.fingers = {f: FingerState((), 0, {}, self._status(f, axes, False))  # (0: an empty sum)
-                                 for f in self.finger_links}
+            statuses = [self._status(f, axes, False) for f in self.finger_links]
+            if statuses != self._idle_statuses:  # (else the fingers' states of the step before hold, unchanged)
+                self.state.fingers = {f: FingerState((), 0, {}, status)  # (0: an empty sum)
+                                      for f, status in zip(self.finger_links, statuses)}
+                self._idle_statuses = statuses
             self._presses, self.pressing = self._pressing_none, False
-            self._reset_sums()
-            self._grip_rule()
+            self._n, self._effort_sum = 0, [0.0] * len(self.names)  # (the force sums are empty)
+            if self._grip_reference is None:  # no finger touches: nothing is gripped, and no part is watched for slip
+                self.state.gripped = ""
+            else:
+                self._grip_rule()
             return
+        self._idle_statuses = None
         pressing: dict[str, dict[str, float]] = {}
         for (finger, uid), total in self._force_sum.items():
             pressing.setdefault(finger, {})[self._target_by_id[uid]] = total / n

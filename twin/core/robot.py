@@ -274,6 +274,11 @@ class Robot:
         return self._traj is not None and not self._settled and self._paused is None
 
     @property
+    def holding(self) -> bool:
+        """Idle and holding its last commanded position, commanded already: `update` would do nothing."""
+        return self._traj is None and self._paused is None and self._held is self._hold
+
+    @property
     def paused(self) -> bool:
         return self._paused is not None
 

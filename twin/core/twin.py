@@ -92,6 +92,7 @@ class Twin:
             self.robot = Robot(self.world.client, self.world.machine,
                                tuple(ROBOT_PREFIX + j for j in st.robot.joints), self.kinematics)
             self.robot.reset([math.radians(a) for a in st.robot.home_deg])
+            self.gripper.read_along(self.robot.joints)  # the arm's joints read with the gripper's after a step
         self.world.check_overlaps()
         self._present = {f"{t.name}.present": True for t in st.targets}  # as written
         self._placed = dict(self._present)  # as applied to the world
@@ -130,17 +131,30 @@ class Twin:
             # step moves the flange in bursts that shake a friction grip loose (measured-facts.md)
             t, h, gripper, robot, world = self.time, self.world.substep, self.gripper, self.robot, self.world
             world.solve_for(gripper.pressing or bool(gripper.state.gripped or gripper.state.attached))
-            for k in range(world.substeps):
-                gripper.drive(k)
-                if robot is not None:
-                    robot.update(t + k * h)
-                if k == 0:  # a cell at rest has its loose bodies frozen: thawed before anything may move them
-                    world.stasis.before_physics(self._machine_still)
-                world.substep_physics()
-                gripper.measure(k == world.substeps - 1)
+            substeps = world.substeps
+            gripper.drive(0)
+            if robot is not None:
+                robot.update(t)
+            world.stasis.before_physics(self._machine_still)  # a cell at rest has its loose bodies frozen: thawed
+            world.substep_physics()  # before anything may move them
+            if gripper.quiet and (robot is None or robot.holding):
+                # nothing is commanded anew in the step's other substeps (the drives keep the first one's settings,
+                # the arm its hold), and nothing is measured until the last: the physics alone runs
+                gripper.coast(substeps - 1)
+                for _ in range(substeps - 1):
+                    world.substep_physics()
+                gripper.measure(True)
+            else:
+                gripper.measure(substeps == 1)
+                for k in range(1, substeps):
+                    gripper.drive(k)
+                    if robot is not None:
+                        robot.update(t + k * h)
+                    world.substep_physics()
+                    gripper.measure(k == substeps - 1)
             self.step_count += 1
             self.gripper.sense()
-            self._publish()
+            self._publish(gripper.along)
             world.stasis.after_step(self._machine_still)
             for device in self.devices:
                 device.after_step(self)
@@ -206,7 +220,9 @@ class Twin:
                 raise SignalError(name, "is an input: only outputs (readings) can be overridden")
         self._outputs = {**self._outputs, **values}
 
-    def _publish(self) -> None:
+    def _publish(self, arm_states=None) -> None:
+        """The outputs as of now, as one new snapshot. `arm_states`: the arm's joints' states as the step read them
+        after its last substep (else they are read here)."""
         g, setpoint, out = self.gripper.state, self.gripper.setpoint, {}
         out["doGripped"] = bool(g.gripped)
         out["GrippedPart"] = g.gripped
@@ -227,7 +243,7 @@ class Twin:
         arm = None
         if self.robot is not None:
             out["robot.busy"] = self.robot.busy(self.time)
-            arm = self.robot.positions()
+            arm = [s[0] for s in arm_states] if arm_states else self.robot.positions()
             for key, q in zip(self._robot_keys, arm):
                 out[key] = q
         pose = self.world.client.getBasePositionAndOrientation
