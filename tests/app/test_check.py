@@ -798,3 +798,34 @@ def test_a_station_on_which_no_grip_can_be_tried_fails_instead_of_passing(tmp_pa
     assert report["verdict"] == "FAIL"
     assert all(g["skipped"] for g in report["grips"]), out
     consistent_exit(code, out)
+
+
+@pytest.mark.parametrize("slide, fine, fine_stiffness", [(40.0, 40.0, None), (100.0, 40.0, None), (100.0, 40.0, 1e6)],
+                         ids=["springy-fine-axis", "stronger-carriage", "stronger-carriage-stiff-fine-axis"])
+def test_a_finger_pressed_through_a_springy_or_weaker_fine_axis_presses_with_the_weakest_effort_and_holds_still(
+        tmp_path, capsys, slide, fine, fine_stiffness):
+    """The same gripper with a fine axis of derived stiffness (a spring the step resolves for its finger and the part,
+    not for the light carriage behind it), or a 100 N carriage on the 40 N fine axis. By statics the finger's force
+    passes through both drives, so it presses with the weaker effort, min(slide, fine), and the doctor expects that;
+    both fingers stall steady (status 2, nothing `moving`, within 0.05 mm) and the block stays put over 5 s (< 0.2 mm
+    relative to the gripper, < 0.5 mm pushed by the closing). Before, the block walked 4-7 mm during the hold."""
+    folder = series_station(tmp_path / "st", slide, fine, fine_stiffness)
+    code, text, report = run_check(folder, tmp_path, capsys, "--hold", "5")
+    assert code == 0 and not lines(text, "FAIL"), text
+    g = grip(report, "block", "outside")
+    fingers = {f["finger"]: f for f in g["fingers"]}
+    assert fingers["fine_b"]["expected_force"] == pytest.approx(min(slide, fine)), text
+    assert fingers["fine_b"]["force"] == pytest.approx(min(slide, fine), rel=0.02), text
+    assert fingers["jaw_a"]["force"] == pytest.approx(40.0, rel=0.02), text
+    assert g["held_creep"] < 0.2e-3 and g["push"] < 0.5e-3, text
+
+
+def test_a_ring_bench_with_two_springy_drives_in_series_on_a_finger_passes_its_check(tmp_path, capsys):
+    """The PLC tests' ring bench: finger 3 is the fine axis L5 (1500 N, 1500 N/mm) on the carriage L4 (the same),
+    both springs the step resolves. Closed to the carriage's range end, finger 3 presses with the chain's 1500 N
+    (statics) within 2 %, as steady as the single-drive fingers (it flickered between status 0 and 2 before)."""
+    folder = STATIONS.parent / "tests" / "plc" / "stations" / "ring_bench"
+    code, text, report = run_check(folder, tmp_path, capsys)
+    assert code == 0 and not lines(text, "FAIL"), text
+    forces = {f["finger"]: f["force"] for f in grip(report, "ring", "outside")["fingers"]}
+    assert forces == pytest.approx({"L2": 1500.0, "L3": 1500.0, "L5": 1500.0}, rel=0.02), text

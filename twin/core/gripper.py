@@ -22,9 +22,12 @@ that the spring is stable), D = m_own / (n h) (its own links alone: a part resti
 them). Drives in series on a pressed finger (a fine axis on its carriage) take out m_own / m of their error per
 substep: the part holds their sum, and only their own links move between them; one pressing on through others that
 stand at their goals presses with at most SERIES_HOLD of what they hold (the finger's force passes through each), so
-they keep their goals instead of trading places with it at equal limits. A station's stiffness above that limit makes
-its drive rigid up to its effort. A free finger follows its command with almost no force; a finger stopped by a part presses with K times how
-far its setpoint lies past it, up to the effort. What the PLC reads is measured, not computed: `NAME.effort` is the
+they keep their goals instead of trading places with it at equal limits; one standing at its goal is never dragged
+off it, and holds it rigidly where the springs in series would press with the chain's weakest effort anyway (its
+spring, derived for finger and part, would rattle the light carriage between a standing part and a constant force).
+A station's stiffness above that limit makes its drive rigid up to its effort. A free finger follows its command with
+almost no force; a finger stopped by a part presses with K times how far its setpoint lies past it, up to the effort.
+What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
 target objects (averaged over the substeps; a revolute finger's is the torque about its joint of those contacts' force, friction included),
 and an axis's speed comes from its positions (pybullet's joint velocity reads the motor's target where a contact
@@ -218,6 +221,10 @@ class Gripper:
             client.resetJointState(body, joint, mult * self.setpoint[master] + off)
         self.closing = self._closing_directions()
         self._series_loads = self._series_couplings()
+        self._series_holders = {s for ss in self._series_loads.values() for s, _ in ss}  # drives others press through
+        self._series_share = {p: dict(ss) for p, ss in self._series_loads.items()}
+        self._holding: set[str] = set()  # series drives holding their goals rigidly against one pressing through them
+        self._index = {name: i for i, name in enumerate(self.names)}
         for joint, master, mult, off in self.mimics:
             self._couple(joint, master, mult, off)
         self._mesh_links: set[int] = set()
@@ -437,6 +444,13 @@ class Gripper:
                         loads.setdefault(p, {})[s] = max(share, loads.get(p, {}).get(s, 0.0))
         return {p: tuple(sorted(ss.items())) for p, ss in loads.items()}
 
+    def chain_effort(self, name: str) -> float:
+        """The most input `name` presses a finger with, along its own motion: its effort, or less where the force
+        passes through drives in series that hold less (a carriage through a weaker fine axis, or the other way
+        round: statics, a finger's force is at most the weakest effort in its chain)."""
+        return min([self.drives[name].effort]
+                   + [self.drives[other].effort / share for other, share in self._series_loads.get(name, ())])
+
     def _chain(self, joint: int) -> list[int]:
         """`joint` and the joints between it and the body's base, nearest first."""
         chain = []
@@ -533,7 +547,9 @@ class Gripper:
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
         axes, presses, series = self.state.axes, self._presses, self._series  # as the last step left them
-        loads = self._series_loads
+        loads, holders = self._series_loads, self._series_holders
+        holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
+        index, series_share = self._index, self._series_share
         for (name, _, moving), (actual, joint_speed, _, _), moved in zip(self._per_input, states, self._speeds):
             d = drives[name]
             g = goal[name]
@@ -562,8 +578,11 @@ class Gripper:
                     # way is pushed at the velocity limit, as a real servo's speed loop does, not run over by the command)
                     rate = max(rate, full / self.rise_time)
                 target = _towards(before, g, rate * h)
-            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once
-            target = min(max(target, actual - full), actual + full)
+            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
+            # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
+            # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
+            if target != g or name not in holders:
+                target = min(max(target, actual - full), actual + full)
             if (target != g and abs(target - actual) >= full * LATCH_FRACTION and (g - actual) * (target - actual) > 0.0
                     and pressing):
                 if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on past
@@ -575,11 +594,38 @@ class Gripper:
             error = target - actual
             toward = joint_speed if error > 0.0 else -joint_speed
             speed = error / h  # to be at the command after the substep, as far as the force allows
-            if series[name] > 1 and pressing:
+            rigid = d.stiffness > d.limit  # stiffer than the step resolves (a station's choice): rigid up to its effort
+            leaning = False
+            if pressing and name in loads:
+                if target != g:  # pressing through drives in series: leaning on those that stand at their goals
+                    leaning = any(command[other] == goal[other] for other, _ in loads[name])
+                elif not rigid and name in holders:
+                    for other, _ in loads[name]:
+                        if command[other] == goal[other]:
+                            continue
+                        # at its goal, another drive pressing on through it: by their springs in series the finger
+                        # would press with K_series times how far its setpoint lies past where it stands (the sum of
+                        # both drives' errors), up to the chain's weakest effort. Where that reaches the effort (a
+                        # carriage sent to its range's end), it holds its goal rigidly instead, as a fine axis
+                        # stiffer than the step resolves: the finger presses with that effort either way, and its
+                        # spring, derived for its finger and the part, would act between a part that stands and the
+                        # light carriage a constant force pushes on (too stiff for that mass: the carriage rattles
+                        # between them, the drives trading places, the part walking)
+                        do, share = drives[other], series_share[other].get(name, 0.0)
+                        if not share:
+                            continue
+                        gap = abs(goal[other] - states[index[other]][0]) + share * abs(g - actual)
+                        springs = 1.0 / (1.0 / do.stiffness + share * share / d.stiffness)
+                        if springs * gap >= LATCH_FRACTION * min(do.effort, d.effort / share):
+                            rigid = True
+                            now_holding.add(name)
+                            break
+            if series[name] > 1 and pressing and not rigid and not any(o in holding for o, _ in loads.get(name, ())):
                 # drives in series on one pressed finger (a fine axis on its carriage): the part holds their sum, and
                 # what moves between them is their own links alone, not the part: each taking its whole error out
                 # in one substep throws the pair against each other (every substep, the part standing); each takes
-                # out the share of it that its own links bear to the mass its gains were derived for
+                # out the share of it that its own links bear to the mass its gains were derived for (leaning on
+                # one that holds rigidly, it presses alone, as on a fine axis stiffer than the step resolves)
                 speed *= d.own / d.mass
             if abs(error) >= full * (1.0 - 1e-9) and toward <= 0.0:
                 # at its force limit and held (or pushed) back: pybullet's solver builds a motor's force only as fast
@@ -591,20 +637,21 @@ class Gripper:
                 speed = d.velocity if speed > 0.0 else -d.velocity
             velocities.append(speed)
             effort = d.effort
-            if pressing and name in loads and target != g:
+            if leaning:
                 # pressing through drives in series that stand at their goals (a carriage through its fine axis):
                 # never harder than they hold, less a reserve, or the one that holds is pushed off its goal at its
                 # limit and the pair trade places, the finger standing (status 0, `moving`, while it presses)
                 for other, share in loads[name]:
                     if command[other] == goal[other]:
                         effort = min(effort, SERIES_HOLD * drives[other].effort / share)
-            if d.stiffness > d.limit:  # stiffer than the step resolves (a station's choice): rigid up to its effort
+            if rigid:
                 forces.append(effort)
             else:
                 forces.append(min(effort, abs(d.stiffness * error - d.damping * joint_speed) + HOLD_FRACTION * d.effort))
             quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
                      and d.stiffness * abs(error) <= HOLD_FRACTION * d.effort)  # a pressing drive: every substep
         self._quiet = quiet
+        self._holding = now_holding
         if quiet and substep == 0 and self.substeps > 1:  # these settings hold for the whole step: the small error
             velocities = [v / self.substeps for v in velocities]  # left is taken out over it, not in every substep
         sent = (velocities, forces)

@@ -9,7 +9,8 @@ judged against issue 18's thresholds (docs/check.md says why each one):
 
     status     2 (closing) / 1 (opening) within 10 steps of touching, and steady while pressing, `moving` off
     noise      the pressing joint's position spread while pressing <= 0.05 mm (0.001 rad)
-    force      the finger's force = its drive's effort (shared over a mimic linkage) within 10 %
+    force      the finger's force = its drive's effort (the weakest in a chain of drives in series, shared over a
+               mimic linkage) within 10 %
     penetration  how deep the nominal shapes overlap (into the part) <= 0.5 mm
     push       a centred part pushed < 0.5 mm by the closing grip
     creep      a resting part < 0.1 mm in the hold time (5 s); a held part < 0.2 mm relative to the gripper
@@ -784,7 +785,7 @@ class Doctor:
             r.closest = pen[f]
             r.penetration = None if pen[f] is None else max(0.0, -pen[f])
             d = drive_of[f]
-            r.expected_force = g.drives[d].effort * self.linkage_share(f, d, fingers)
+            r.expected_force = g.chain_effort(d) * self.linkage_share(f, d, fingers)  # the weakest in its chain
         result.weight = self.weight(name)
         result.capacity = mu * sum(r.normal_force for r in res.values())
         self.judge(where, want, status, res, moving, result, mu)
