@@ -60,7 +60,7 @@ from .bullet import pybullet
 
 from .mechanism import JointInput, Mechanism
 from .meshes import HULL_MARGIN, prepared
-from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # noqa: F401 (what the signals mean)
+from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # (what the signals mean)
 from .signals import FLOAT, INPUT, SignalSpec
 from .station import GripperSpec
 from .world import COLLISION_MARGIN
@@ -252,6 +252,8 @@ class Gripper:
         self._sent: tuple | None = None
         self._per_input = [(name, self.unit[name], MOVING_SPEED[self.unit[name]]) for name in self.names]
         self._ranges = [(name, *self._range[name]) for name in self.names]
+        self._servo_limits = {f: [(name, IN_POSITION_TOLERANCE[self.unit[name]], MOVING_SPEED[self.unit[name]])
+                                  for name in servos] for f, servos in self.finger_servos.items()}
         self.read_along([])
         self._idle_statuses: list[int] | None = None  # the fingers' statuses while their states are of touching nothing
         self._joint_axis = {f: client.getJointInfo(body, j)[13] for f, j in self.finger_joint.items()}
@@ -706,17 +708,20 @@ class Gripper:
             self._speeds = [(s[0] - b[0]) / elapsed for s, b in zip(states, before)]
         self._ticks = 0
         self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
-        sums, keys = self._force_sum, self._link_keys
-        self._joint_frames.clear()
+        sums, key_of = self._force_sum, self._link_keys.get
+        if self._joint_frames:
+            self._joint_frames.clear()
         for pt in self._contact_points(self.body):  # one query for all of the machine's contacts (a crowded cell's
             # parts that touch nothing cost nothing), its finger links' on targets kept
-            if pt[9] <= 0.0:
+            force = pt[9]
+            if force <= 0.0:
                 continue
-            key = keys.get((pt[3], pt[2]))
+            key = key_of((pt[3], pt[2]))
             if key is None:  # not a finger link on a target
                 continue
             key, revolute = key
-            force = abs(self._torque(key[0], pt)) if revolute else pt[9]
+            if revolute:
+                force = abs(self._torque(key[0], pt))
             sums[key] = sums.get(key, 0.0) + force
 
     def _torque(self, finger: str, pt) -> float:
@@ -843,13 +848,12 @@ class Gripper:
         moves; else stopped by contact when one of them (the nearest) stands short of its goal with its drive
         pushing; else at the setpoint."""
         stopped = None
-        for name in self.finger_servos[finger]:
-            goal = self._hold[name] if self._hold is not None else self.setpoint[name]
-            axis, unit = axes[name], self.unit[name]
-            tolerance = IN_POSITION_TOLERANCE[unit]
+        goals = self._hold if self._hold is not None else self.setpoint
+        for name, tolerance, moving in self._servo_limits[finger]:
+            goal, axis = goals[name], axes[name]
             if abs(goal - axis.actual) <= tolerance:
                 continue
-            if abs(axis.velocity) > MOVING_SPEED[unit] or abs(self.command_position[name] - axis.actual) <= tolerance:
+            if abs(axis.velocity) > moving or abs(self.command_position[name] - axis.actual) <= tolerance:
                 return STATUS_MOVING
             if stopped is None:
                 stopped = STATUS_CLOSING_CONTACT if (goal - axis.actual) * self.closing[name] > 0 else STATUS_OPENING_CONTACT

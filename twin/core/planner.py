@@ -103,7 +103,10 @@ class MotionQueue:
     @property
     def end(self) -> float:
         """When the last motion ends (0 when empty)."""
-        return max((s.end for s in self.segments), default=0.0)
+        segments = self.segments
+        if len(segments) == 1:  # (the common case, asked at every physics substep)
+            return segments[0].end
+        return max((s.end for s in segments), default=0.0)
 
     @property
     def q_end(self) -> np.ndarray:

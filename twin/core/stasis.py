@@ -46,9 +46,11 @@ class Stasis:
         if not self.frozen:
             return
         if machine_still():
-            c = self.client
-            if all(c.getBasePositionAndOrientation(uid) == pose and c.getBaseVelocity(uid) == STANDING
-                   for uid, (_, pose, _) in self.frozen.items()):
+            pose_of, velocity_of = self.client.getBasePositionAndOrientation, self.client.getBaseVelocity
+            for uid, (_, pose, _) in self.frozen.items():
+                if pose_of(uid) != pose or velocity_of(uid) != STANDING:
+                    break
+            else:
                 return
         self.thaw()
 

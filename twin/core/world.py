@@ -314,7 +314,9 @@ class World:
             self.client = BulletClient(connection_mode=pybullet.DIRECT)
             self._build(station, gripper_root)
         bind_calls(self.client)
-        self._step_simulation = self.client.stepSimulation
+        # one physics substep (a simulation step is `substeps` of them): pybullet's call itself, bound once (a
+        # method around it would cost a Python call at every substep)
+        self.substep_physics = self.client.stepSimulation
         from .stasis import Stasis
 
         loose = [self.body_ids[b.name] for b in (*station.fixtures, *station.targets) if b.dynamic]
@@ -390,10 +392,6 @@ class World:
         if pressing != self._pressing:
             self._pressing = pressing
             self.client.setPhysicsEngineParameter(solverResidualThreshold=self._residuals[pressing])
-
-    def substep_physics(self) -> None:
-        """One physics substep (a simulation step is `substeps` of them)."""
-        self._step_simulation()
 
     def check_overlaps(self, tolerance: float = OVERLAP_TOLERANCE) -> None:
         """StationError when a target starts inside the gripper, the arm, a fixture or another target: physics
