@@ -6,6 +6,8 @@ from __future__ import annotations
 import asyncio
 import math
 import struct
+import subprocess
+import sys
 import time
 import xml.etree.ElementTree as ET
 
@@ -272,6 +274,61 @@ def test_sim_advance_reproduces_a_modbus_lockstep_run_bit_for_bit(rmap):
     by_opcua = grip_run(True, rmap)
     assert len(by_modbus) > 3
     assert by_opcua == by_modbus  # Doubles compared exactly, Modbus registers too
+
+
+def cpu_hogs(n: int = 2) -> list[subprocess.Popen]:
+    """Busy loops beside the server, one a core of this 2-core machine (a loaded machine, on purpose): the OPC UA
+    process falls behind the simulation's, as it does under load."""
+    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+
+
+def test_writes_and_advances_over_either_front_end_keep_their_order_under_load(rmap):
+    """The lockstep contract across the two front ends, with CPU hogs beside them: a write answered Good (or
+    acknowledged over Modbus) before an advance asked on the other protocol is applied at the advance's first
+    step, and a read over OPC UA after an advance done over Modbus shows that advance's last step (the OPC UA
+    process publishes what the simulation's process stepped; a read there must not answer from a step
+    earlier). Checked against the same writes and steps on a cell stepped in process, bit for bit."""
+    from twin_app.cell import Cell
+
+    # (mm, steps, advanced over Modbus): one step right after a write, and runs long enough for the OPC UA
+    # process to fall behind the simulation's (30 steps: about 0.4 s of simulated time each)
+    schedule = [(345.0 - 1.0 * i, (1, 30, 3)[i % 3], i % 3 != 2) for i in range(15)]
+    outputs = [e.name for e in rmap if e.access == "r" and (e.name == "sim.step" or not e.name.startswith("sim."))]
+    seen = []
+    hogs = cpu_hogs()
+    try:
+        with OpcUaServerProcess(RING_RIG, "--lockstep") as server, modbus(server) as mb:
+            async def main():
+                async with Client(server.url, timeout=240) as c:
+                    ns = await namespace(c)
+                    nodes = [node(c, ns, n) for n in outputs]
+                    for mm, steps, over_modbus in schedule:
+                        counts = round(mm * 100)
+                        if over_modbus:  # written over OPC UA, stepped over Modbus, read over OPC UA
+                            for name in ("L2", "L3", "L4"):
+                                value = rmap[name].si_of_words([counts])
+                                assert await write_status(node(c, ns, name), value, ua.VariantType.Double) == "Good"
+                            modbus_advance(mb, rmap, steps)
+                        else:  # written over Modbus, stepped over OPC UA
+                            assert not mb.write_registers(rmap["L2"].address, [counts] * 3, device_id=UNIT).isError()
+                            await advance(c, ns, steps)
+                        seen.append(dict(zip(outputs, await c.read_values(nodes))))
+            run(main())
+    finally:
+        for hog in hogs:
+            hog.kill()
+            hog.wait()
+    with Cell(RING_RIG) as cell:
+        cell.pace(lockstep=True)
+        expected = []
+        for mm, steps, _ in schedule:
+            value = rmap["L2"].si_of_words([round(mm * 100)])
+            cell.exchange.submit([("L2", value), ("L3", value), ("L4", value)])
+            cell.step(steps)
+            expected.append({n: cell.exchange.snapshot.values[n] for n in outputs})
+    assert [s["sim.step"] for s in seen] == [e["sim.step"] for e in expected]
+    assert any(s["L2.moving"] for s in seen), "nothing moved: the comparison saw a static cell"
+    assert seen == expected  # doubles compared exactly
 
 
 # -- subscriptions -------------------------------------------------------------------------------------

@@ -38,9 +38,14 @@ simulated time, and writes what it received even when the simulation's process d
   the step count when n more steps are done; `remote.feed(source, clock_only)` feeds the comm-loss
   watchdog; `remote.control(action)` pauses, resumes or steps the runner (the page's buttons);
   `remote.event(kind, **fields)` hands a client's coming and going (`client_connected`, `client_gone`,
-  `client_refused`) to the cell's one events writer (`twin serve --events`), stamped with its step there.
+  `client_refused`) to the cell's one events writer (`twin serve --events`), stamped with its step there;
+  `await remote.sync()` returns once every snapshot the cell had published when it got the request has
+  reached this process's subscribers (the cell's step count then).
 - One ordered channel each way, so a write answered before a `Sim.Advance` is applied in the advance's first
-  step: lockstep runs stay bit for bit. The simulation's side never waits for the process: it reads the
+  step, and an advance's answer comes after its last step's snapshot: lockstep runs stay bit for bit. The
+  process's snapshots trail the cell's by the channel, so steps another front end asked for (a Modbus
+  client's `sim.advance`) may not have reached it yet when its client asks next: a lockstep front end
+  `sync`s before it answers a read, and the client reads what the cell had done when it asked. The simulation's side never waits for the process: it reads the
   channel in its event loop (no thread) and its writes are buffered by asyncio; a process that stops
   reading for `MAX_BACKLOG` bytes is cut off (logged) and the simulation goes on. If the process dies, the
   simulation goes on without it.
@@ -313,6 +318,8 @@ class FrontEndProcess:
             self._send(("reply", i, reply))
         elif kind == "advance":
             self._advance(msg[1], msg[2])
+        elif kind == "sync":  # answered behind every snapshot already sent (one ordered channel)
+            self._send(("reply", msg[1], ("ok", self.cell.exchange.twin.step_count)))
         elif kind == "feed":
             watchdog = getattr(self.cell, "watchdog", None)
             if watchdog is not None and watchdog.timeout:
@@ -422,6 +429,12 @@ class Remote:
     async def advance(self, n: int) -> int:
         """Lockstep: run n more steps; the step count once they are done."""
         return await self._ask("advance", int(n))
+
+    async def sync(self) -> int:
+        """Once every snapshot the cell had published when it got this request has been handed to the
+        subscribers (and awaited): the cell's step count then. A read answered after it shows every step any
+        front end had run before the read was asked for."""
+        return await self._ask("sync", None)
 
     def feed(self, source: str, clock_only: bool = False) -> None:
         """A client's request (the comm-loss watchdog; `twin.runtime.watchdog`)."""

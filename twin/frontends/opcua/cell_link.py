@@ -13,7 +13,9 @@ shares the simulation's interpreter. Through `Remote` (the adapter's view of the
   it is applied at the next step in arrival order with every other front end's writes. `Sim.Advance` is
   answered when its steps are done. Every request of a session feeds the comm-loss watchdog.
 - one ordered channel: a write answered before a `Sim.Advance` is applied in the advance's first step, and
-  what a client reads after an advance is its last step's: lockstep runs stay bit for bit.
+  what a client reads after an advance is its last step's: lockstep runs stay bit for bit. In lockstep a
+  read first syncs with the cell (`Remote.sync`), so steps another front end ran (a Modbus client's
+  `sim.advance`) are published here before the read is answered.
 - OPC UA clients coming and going (`sessions`) are handed to the cell as `client_connected` / `client_gone`
   events, which the simulation's one events writer writes (`twin serve --events`), and logged there.
 """
@@ -57,6 +59,9 @@ class RemoteLink:
         except TwinError as exc:  # the simulation is gone
             raise AdvanceRefused("BadDeviceFailure", str(exc)) from None
 
+    async def sync(self) -> int:
+        return await self.remote.sync()
+
     def feed(self, source: str, clock_only: bool = False) -> None:
         self.remote.feed(source, clock_only)
 
@@ -90,7 +95,8 @@ class OpcUaProcess:
         space = build_address_space(remote.signals, remote.station)
         server = OpcUaServer(space, step_s=remote.dt, submit=link.submit, advance=link.advance,
                              security=o["security"], on_request=link.feed if o["watchdog"] else None,
-                             clock_requests=remote.lockstep, on_client=link.client)
+                             clock_requests=remote.lockstep, on_client=link.client,
+                             sync=link.sync if remote.lockstep else None)
         from .security import SecurityError
 
         try:

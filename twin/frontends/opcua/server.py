@@ -21,6 +21,10 @@ validated writes to the cell, which applies them at the start of the next step:
 - Subscriptions are asyncua's: a monitored item's RevisedSamplingInterval is at least the step (a value
   changes at most once a step; -1 is the publishing interval); the publishing interval and the queue size
   are what the client asked (asyncua's queue of 0 is its maximum, 10000: every step of a publishing interval).
+- Reads in lockstep (`sync`): a Read of a signal's value first waits, in asyncua's PreRead callback, until
+  every step the cell had run when the read came has been published here (steps another front end asked
+  for, a Modbus client's `sim.advance`, included): a client that saw an advance done anywhere reads its
+  last step. In real time a read answers from the last step published, at once.
 - `Sim.Advance(steps)` (lockstep only) runs that many steps and returns the step count when they are done.
   asyncua answers a connection's requests in order, so the call holds that connection's other requests until
   its steps are done (an asyncua client's keep-alive probe gives up after 1 s: advance in shorter chunks).
@@ -44,6 +48,7 @@ from asyncua.ua.ua_binary import struct_from_binary
 
 from .address_space import (ADVANCE_METHOD, BOOLEAN, DOUBLE, INT32, INT64, SIM_FOLDER, STRING, UINT32, AddressSpace,
                             Variable)
+from twin.core.errors import TwinError
 from twin.core.signal_table import SIM_ADVANCE
 
 from .errors import AdvanceRefused
@@ -63,6 +68,7 @@ MAX_ADVANCE = 2**32 - 1
 
 Submit = Callable[[Sequence[tuple[Variable, object]]], Awaitable[str | None]]  # -> None, or a Bad status code's name
 Advance = Callable[[int], Awaitable[int]]  # lockstep: run n steps, return the step count when done
+Sync = Callable[[], Awaitable[object]]  # lockstep: returns once every step the cell has run is published here
 OnRequest = Callable[[str, bool], None]  # (source, clock_only): a session's request came (the comm-loss watchdog)
 
 log = logging.getLogger("twin.frontends.opcua")
@@ -118,16 +124,19 @@ class OpcUaServer:
 
     def __init__(self, space: AddressSpace, *, step_s: float, submit: Submit, advance: Advance | None = None,
                  security: Security | None = None, server_name: str | None = None,
-                 on_request: OnRequest | None = None, clock_requests: bool = False, on_client: OnClient | None = None):
+                 on_request: OnRequest | None = None, clock_requests: bool = False, on_client: OnClient | None = None,
+                 sync: Sync | None = None):
         """`on_request(source, clock_only)` is called for every request of an activated session (source:
         "opcua HOST:PORT" and the account's "user 'NAME'"); with `clock_requests` (lockstep), `clock_only` tells
         a request that only drives or reads simulated time (Sim.Advance calls, reads and writes of
-        `sim.advance`). `on_client(kind, **fields)`: a client connected or gone (`sessions`)."""
+        `sim.advance`). `on_client(kind, **fields)`: a client connected or gone (`sessions`). `sync`
+        (lockstep): awaited before a read of a signal is answered (see the module docstring)."""
         self.space = space
         self.on_request, self.clock_requests = on_request, clock_requests
         self.step_ms = step_s * 1000.0
         self._submit = submit
         self._advance = advance
+        self._sync = sync
         self.security = security or Security()
         self.server = Server(user_manager=self.security.user_manager())
         self.server_name = server_name or f"gripper-twin {space.station}"
@@ -168,6 +177,8 @@ class OpcUaServer:
         srv.subscribe_server_callback(CallbackType.PostWrite, self._post_write)
         srv.subscribe_server_callback(CallbackType.ItemSubscriptionCreated, self._revise_sampling)
         srv.subscribe_server_callback(CallbackType.ItemSubscriptionModified, self._revise_sampling)
+        if self._sync is not None:
+            srv.subscribe_server_callback(CallbackType.PreRead, self._pre_read)
         if any(a.read_only for a in self.security.accounts):
             srv.subscribe_server_callback(CallbackType.PostRead, self._user_access_level)
         self.sessions.install()
@@ -362,6 +373,16 @@ class OpcUaServer:
             items[i] = wv
             results[i] = statuses.get(i) or _status("BadInternalError")
 
+    async def _pre_read(self, event, _dispatcher) -> None:
+        """asyncua's PreRead callback (lockstep): a Read of a signal's value waits until this process has
+        published every step the cell had run when it came (see the module docstring)."""
+        nodes = self._nodes
+        if any(rv.NodeId in nodes for rv in event.request_params.NodesToRead or ()):
+            try:
+                await self._sync()
+            except TwinError:  # the simulation is gone: its last published step it is
+                pass
+
     def _revise_sampling(self, event, _dispatcher) -> None:
         """asyncua's ItemSubscriptionCreated/Modified callback: no item samples faster than the step (values
         change once a step); -1, the publishing interval (asyncua's answer for a new item), the same."""
@@ -478,8 +499,6 @@ def _validate(var: Variable, value) -> tuple[str | None, object]:
     spec = var.spec
     check = getattr(spec, "check", None)
     if check is not None:
-        from twin.core.errors import TwinError
-
         from .errors import status_of
 
         try:
