@@ -39,16 +39,22 @@ simulated time, and writes what it received even when the simulation's process d
   watchdog; `remote.control(action)` pauses, resumes or steps the runner (the page's buttons);
   `remote.event(kind, **fields)` hands a client's coming and going (`client_connected`, `client_gone`,
   `client_refused`) to the cell's one events writer (`twin serve --events`), stamped with its step there;
-  `await remote.sync()` returns once every snapshot the cell had published when it got the request has
-  reached this process's subscribers (the cell's step count then).
+  `await remote.sync()` returns once every step the cell had run when it was called has reached this
+  process's subscribers (see the watermark below).
 - One ordered channel each way, so a write answered before a `Sim.Advance` is applied in the advance's first
   step, and an advance's answer comes after its last step's snapshot: lockstep runs stay bit for bit. The
-  process's snapshots trail the cell's by the channel, so steps another front end asked for (a Modbus
-  client's `sim.advance`) may not have reached it yet when its client asks next: a lockstep front end
-  `sync`s before it answers a read, and the client reads what the cell had done when it asked. The simulation's side never waits for the process: it reads the
-  channel in its event loop (no thread) and its writes are buffered by asyncio; a process that stops
-  reading for `MAX_BACKLOG` bytes is cut off (logged) and the simulation goes on. If the process dies, the
-  simulation goes on without it.
+  simulation's side never waits for the process: it reads the channel in its event loop (no thread) and its
+  writes are buffered by asyncio; a process that stops reading for `MAX_BACKLOG` bytes is cut off (logged)
+  and the simulation goes on. If the process dies, the simulation goes on without it.
+- The watermark. The process's snapshots trail the cell's by the channel, so steps another front end asked
+  for (a Modbus client's `sim.advance`) may not have reached it when its own client asks next (on a loaded
+  machine, often). So both processes map one watermark (a file in the adapter's private folder, unlinked
+  once the process has connected) where the cell writes the step of every snapshot right after writing the
+  snapshot into the channel, before any client can see that step done (and its complement: a value read
+  while it is written does not match, and is read again). `sync` reads it and, when it is ahead
+  of the process's last snapshot, waits for that snapshot: a lockstep front end `sync`s before it answers a
+  read, so a client reads at least what it saw done anywhere. It needs no turn of the simulation's loop: a
+  front end still answers while that loop is busy.
 
 **Pipes, not shared memory (measured: `python -m bench adapter`).** One snapshot of the ring rig (75 signals,
 one of them text) costs the simulation's process 26 us of CPU through a Unix socket (every value pickled,
@@ -57,7 +63,8 @@ one of them text) costs the simulation's process 26 us of CPU through a Unix soc
 (a reader that looks late misses a step, and OPC UA must publish every step), holds no text, makes the
 reader poll, and still needs a second channel, ordered with the snapshots, for writes and `Sim.Advance`. A
 socket carries every step in order, text included, wakes the reader only when there is something to
-read, and is the write channel too; the adapter sends only the values that changed, cheaper still.
+read, and is the write channel too; the adapter sends only the values that changed, cheaper still. Only
+the watermark, one word, is shared.
 """
 from __future__ import annotations
 
@@ -65,6 +72,7 @@ import asyncio
 import importlib
 import inspect
 import logging
+import mmap
 import multiprocessing
 import os
 import pickle
@@ -86,6 +94,7 @@ START_TIMEOUT = 60.0  # s a process may take to start its front end
 RUNNER_ACTIONS = ("pause", "resume", "single_step", "request")
 CLIENT_EVENTS = ("client_connected", "client_gone", "client_refused")  # what a front end's process may report
 _HEADER = struct.Struct("!I")
+MARK_BYTES = 16  # the watermark: the step of the last snapshot written into the channel, then its complement
 
 
 # -- the wire: length-prefixed pickles over a Unix socket, read and written by asyncio on both sides --------
@@ -153,6 +162,8 @@ class FrontEndProcess:
         self._started: asyncio.Future | None = None
         self._bye: asyncio.Future | None = None
         self._cut = False
+        self._map: mmap.mmap | None = None
+        self._mark: memoryview | None = None  # the watermark, as two int64 words
 
     # -- life cycle --------------------------------------------------------------------------------
     async def start(self, cell) -> list[str]:
@@ -163,15 +174,21 @@ class FrontEndProcess:
         # the process connects to a socket only this user can reach (passing a socket to a spawned process
         # would start a thread here to hand it over)
         folder = tempfile.mkdtemp(prefix="twin-frontend-")
-        address = os.path.join(folder, "cell")
+        address, mark = os.path.join(folder, "cell"), os.path.join(folder, "step")
         listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         try:
+            with open(mark, "w+b") as f:  # the watermark (the process maps it before it connects)
+                f.write(bytes(MARK_BYTES))
+                f.flush()
+                self._map = mmap.mmap(f.fileno(), MARK_BYTES)
+                self._mark = memoryview(self._map).cast("q")
+                _set_mark(self._mark, 0)
             listener.bind(address)
             listener.listen(1)
             listener.setblocking(False)
             ctx = multiprocessing.get_context("spawn")  # a clean interpreter: no pybullet, no event loop copied
             self.process = ctx.Process(target=child_main, name=f"twin-{self.name}", daemon=True,
-                                       args=(self.target, address))
+                                       args=(self.target, address, mark))
             self.process.start()
             try:
                 mine, _ = await asyncio.wait_for(loop.sock_accept(listener), self.start_timeout)
@@ -222,6 +239,10 @@ class FrontEndProcess:
 
     async def _end(self) -> None:
         local, self.local = self.local, None
+        if self._map is not None:
+            self._mark.release()
+            self._map.close()
+            self._mark = self._map = None
         if local is not None:
             local.close()
         if self._writer is not None:
@@ -240,17 +261,19 @@ class FrontEndProcess:
         self._fail_waiting()
 
     # -- cell -> process ---------------------------------------------------------------------------
-    def _send(self, msg) -> None:
+    def _send(self, msg) -> bool:
+        """Write a message into the channel; False when the process is gone or cut off."""
         w = self._writer
         if w is None or self._cut or w.is_closing():
-            return
+            return False
         if w.transport.get_write_buffer_size() > MAX_BACKLOG:
             self._cut = True
             self.cell.log(f"{self.name}: its process stopped reading ({MAX_BACKLOG >> 20} MiB behind): cut off; "
                           "the simulation goes on without it", logging.WARNING)
             w.close()
-            return
+            return False
         w.write(_frame(msg))
+        return True
 
     def _send_snapshot(self, snapshot) -> None:
         sent = self._sent
@@ -259,7 +282,8 @@ class FrontEndProcess:
         sent.update(changed)
         if snapshot.step != self._last_step:  # a step applied every batch accepted before it
             self._last_step, self._applied = snapshot.step, self._accepted
-        self._send(("snap", snapshot.step, snapshot.time, changed, self._applied))
+        if self._send(("snap", snapshot.step, snapshot.time, changed, self._applied)) and self._mark is not None:
+            _set_mark(self._mark, snapshot.step)  # after the snapshot is in the channel, never before
 
     def _on_snapshot(self, snapshot) -> None:
         self._send_snapshot(snapshot)
@@ -318,8 +342,6 @@ class FrontEndProcess:
             self._send(("reply", i, reply))
         elif kind == "advance":
             self._advance(msg[1], msg[2])
-        elif kind == "sync":  # answered behind every snapshot already sent (one ordered channel)
-            self._send(("reply", msg[1], ("ok", self.cell.exchange.twin.step_count)))
         elif kind == "feed":
             watchdog = getattr(self.cell, "watchdog", None)
             if watchdog is not None and watchdog.timeout:
@@ -390,7 +412,7 @@ class RemoteSnapshot:
 class Remote:
     """The cell as a front end's process sees it: its signal table, every step's snapshot, and the way back."""
 
-    def __init__(self, hello: dict, writer: asyncio.StreamWriter):
+    def __init__(self, hello: dict, writer: asyncio.StreamWriter, mark: memoryview | None = None):
         self.name, self.options = hello["name"], hello["options"]
         self.station, self.dt, self.mode = hello["station"], hello["dt"], hello["mode"]
         self.signals = hello["signals"]
@@ -403,6 +425,8 @@ class Remote:
         self._local: list[Callable[[object], None]] = []
         self._replies: dict[int, asyncio.Future] = {}
         self._next = 0
+        self._mark = mark  # the watermark (see the module docstring)
+        self._syncing: list[tuple[int, asyncio.Future]] = []  # `sync`: (step awaited, its future)
 
     @property
     def lockstep(self) -> bool:
@@ -431,10 +455,26 @@ class Remote:
         return await self._ask("advance", int(n))
 
     async def sync(self) -> int:
-        """Once every snapshot the cell had published when it got this request has been handed to the
-        subscribers (and awaited): the cell's step count then. A read answered after it shows every step any
-        front end had run before the read was asked for."""
-        return await self._ask("sync", None)
+        """Once every step the cell had run when this was called has been handed to the subscribers (and
+        awaited): the step of the snapshot then. A read answered after it shows every step any front end had
+        seen done before the read was asked for. Needs no turn of the simulation's loop (the watermark)."""
+        step = self.cell_step()
+        if step <= self.snapshot.step:
+            return self.snapshot.step
+        fut = asyncio.get_running_loop().create_future()
+        self._syncing.append((step, fut))
+        return await fut
+
+    def cell_step(self) -> int:
+        """The step of the last snapshot the cell has written into the channel (the watermark)."""
+        mark = self._mark
+        if mark is None:
+            return self.snapshot.step
+        while True:  # a value and its complement: a write seen halfway does not match, and is read again
+            step, check = mark[0], mark[1]
+            if check == ~step:
+                return step
+            os.sched_yield()  # the cell's process is between the two words
 
     def feed(self, source: str, clock_only: bool = False) -> None:
         """A client's request (the comm-loss watchdog; `twin.runtime.watchdog`)."""
@@ -485,6 +525,13 @@ class Remote:
             except Exception as exc:  # noqa: BLE001 - one step's trouble, said in one line; the next step comes
                 self.log(f"{self.name}: step {step} could not be published: {type(exc).__name__}: {exc}",
                          logging.ERROR)
+        if self._syncing:
+            waiting, self._syncing = self._syncing, []
+            for target, fut in waiting:
+                if target > step:
+                    self._syncing.append((target, fut))
+                elif not fut.done():
+                    fut.set_result(step)
 
     def _reply(self, i: int, reply: tuple) -> None:
         fut = self._replies.pop(i, None)
@@ -496,26 +543,37 @@ class Remote:
             fut.set_exception(error_from(reply))
 
     def _gone(self) -> None:
-        for fut in self._replies.values():
+        for fut in [*self._replies.values(), *(f for _, f in self._syncing)]:
             if not fut.done():
                 fut.set_exception(TwinError("the simulation is gone"))
         self._replies.clear()
+        self._syncing.clear()
 
 
-def child_main(target: str, address: str) -> None:
+def _set_mark(mark: memoryview, step: int) -> None:
+    """The watermark: the step, then its complement (each an aligned 8-byte word, written whole)."""
+    mark[0] = step
+    mark[1] = ~step
+
+
+def child_main(target: str, address: str, mark: str | None = None) -> None:
     """The front end's process: run the front end `target` names until the cell says stop (or is gone)."""
+    watermark = None
+    if mark is not None:  # mapped before connecting: the cell unlinks it once the process has connected
+        with open(mark, "rb") as f:
+            watermark = memoryview(mmap.mmap(f.fileno(), MARK_BYTES, access=mmap.ACCESS_READ)).cast("q")
     sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     sock.connect(address)
     try:
-        asyncio.run(_child(target, sock))
+        asyncio.run(_child(target, sock, watermark))
     except KeyboardInterrupt:
         pass
 
 
-async def _child(target: str, sock: socket.socket) -> None:
+async def _child(target: str, sock: socket.socket, mark: memoryview | None = None) -> None:
     reader, writer = await asyncio.open_connection(sock=sock)
     msg = await _read(reader)
-    remote = Remote(msg[1], writer)
+    remote = Remote(msg[1], writer, mark)
     stop = asyncio.Event()
 
     async def read_loop() -> None:  # from the start: a front end may ask the cell while it starts
