@@ -557,40 +557,51 @@ class Gripper:
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
-            # held: the joint moved slower than HELD_SHARE of its velocity limit the way its goal lies (last substep)
-            held = (moved if g > actual else -moved) < HELD_SHARE * d.velocity
-            if name in turned:
-                turned.discard(name)
-                if (g - actual) * (before - actual) < 0.0:
-                    before = actual  # a new goal the other way: the drive turns at once, from where the joint is
-                    stalled[name] = None
             full = d.effort / d.stiffness
-            way = stalled.get(name)
-            if way is not None and (g - before) * way > 0.0 and (before - actual) * way > RELEASE_FRACTION * full:
-                target = before  # stalled on a part: the command waits, so the finger holds where the part stopped it
-                if (target - actual) * way < full * FOLLOW_FRACTION:  # the part gave way: followed, pressing as stalled
-                    target = actual + way * full * LATCH_FRACTION
-                    if (g - target) * way < 0.0:
-                        target = g
-            else:
+            if before == g and not pressing and name not in turned and stalled.get(name) is None:
+                # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the ramp
+                # below gives, in short: the goal itself, within full force of the joint unless others press through it
                 way = None
-                rate = d.velocity
-                if (before - actual) * (g - actual) > 0.0 and pressing and held:
-                    # pressing on a part that holds the finger: full force within the rise time (a part that gives
-                    # way is pushed at the velocity limit, as a real servo's speed loop does, not run over by the command)
-                    rate = max(rate, full / self.rise_time)
-                target = _towards(before, g, rate * h)
-            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
-            # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
-            # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
-            if target != g or name not in holders:
-                target = min(max(target, actual - full), actual + full)
-            if (target != g and abs(target - actual) >= full * LATCH_FRACTION and (g - actual) * (target - actual) > 0.0
-                    and pressing):
-                if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on past
-                    # it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
-                    target = actual + (1.0 if target > actual else -1.0) * full * LATCH_FRACTION
-                way = 1.0 if target > actual else -1.0  # held short of its goal by a part, at its force limit: stalled
+                target = g if name in holders else min(max(g, actual - full), actual + full)
+            else:
+                # held: the joint moved slower than HELD_SHARE of its velocity limit the way its goal lies (last
+                # substep)
+                held = (moved if g > actual else -moved) < HELD_SHARE * d.velocity
+                if name in turned:
+                    turned.discard(name)
+                    if (g - actual) * (before - actual) < 0.0:
+                        before = actual  # a new goal the other way: the drive turns at once, from where the joint is
+                        stalled[name] = None
+                way = stalled.get(name)
+                if way is not None and (g - before) * way > 0.0 and (before - actual) * way > RELEASE_FRACTION * full:
+                    # stalled on a part: the command waits, so the finger holds where the part stopped it
+                    target = before
+                    if (target - actual) * way < full * FOLLOW_FRACTION:
+                        # the part gave way: followed, pressing as stalled
+                        target = actual + way * full * LATCH_FRACTION
+                        if (g - target) * way < 0.0:
+                            target = g
+                else:
+                    way = None
+                    rate = d.velocity
+                    if (before - actual) * (g - actual) > 0.0 and pressing and held:
+                        # pressing on a part that holds the finger: full force within the rise time (a part that
+                        # gives way is pushed at the velocity limit, as a real servo's speed loop does, not run over by
+                        # the command)
+                        rate = max(rate, full / self.rise_time)
+                    target = _towards(before, g, rate * h)
+                # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
+                # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
+                # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
+                if target != g or name not in holders:
+                    target = min(max(target, actual - full), actual + full)
+                if (target != g and abs(target - actual) >= full * LATCH_FRACTION
+                        and (g - actual) * (target - actual) > 0.0 and pressing):
+                    if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on
+                        # past it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
+                        target = actual + (1.0 if target > actual else -1.0) * full * LATCH_FRACTION
+                    # held short of its goal by a part, at its force limit: stalled
+                    way = 1.0 if target > actual else -1.0
             stalled[name] = way
             command[name] = target
             error = target - actual

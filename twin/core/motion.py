@@ -190,6 +190,10 @@ class Trajectory:
         self._n = len(self._knots) - 1
         self._s = np.linspace(0.0, 1.0, self._n + 1) if s_knots is None else np.array(s_knots, dtype=float)
         self._s_list = self._s.tolist()  # (looked up at every physics substep: bisect on a list beats numpy's search)
+        # each knot interval's step and slope dq/ds, as `_at` would form them at every physics substep
+        self._steps = np.diff(self._knots, axis=0)
+        with np.errstate(divide="ignore", invalid="ignore"):  # (an interval of no length is never looked up)
+            self._slopes = self._steps / np.diff(self._s)[:, None]
         self.profile = profile
         self.duration = profile.duration
         self.path = path
@@ -210,9 +214,8 @@ class Trajectory:
             return self._knots[0].copy(), np.zeros(self._knots.shape[1])
         i = min(max(bisect.bisect_right(self._s_list, s) - 1, 0), self._n - 1)
         s0, s1 = self._s_list[i], self._s_list[i + 1]
-        a, b = self._knots[i], self._knots[i + 1]
         f = (s - s0) / (s1 - s0)
-        return a + f * (b - a), (b - a) / (s1 - s0)
+        return self._knots[i] + f * self._steps[i], self._slopes[i]
 
     def q(self, t: float) -> np.ndarray:
         s, _ = self.profile.s(t)

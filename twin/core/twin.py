@@ -98,6 +98,8 @@ class Twin:
         self._placed = dict(self._present)  # as applied to the world
         self._target_of = {f"{t.name}.present": t for t in st.targets}
         self._outputs: dict[str, object] = {}
+        self._published: dict[str, object] = {}  # the last snapshot as published (before any override_outputs)
+        self._published_fingers = None  # the fingers' states it shows
         self._index_outputs()
         self._publish()
 
@@ -223,7 +225,8 @@ class Twin:
     def _publish(self, arm_states=None) -> None:
         """The outputs as of now, as one new snapshot. `arm_states`: the arm's joints' states as the step read them
         after its last substep (else they are read here)."""
-        g, setpoint, out = self.gripper.state, self.gripper.setpoint, {}
+        g, setpoint, last = self.gripper.state, self.gripper.setpoint, self._published
+        out = last.copy()  # (the step before's snapshot, as published: what did not change is not formed anew)
         out["doGripped"] = bool(g.gripped)
         out["GrippedPart"] = g.gripped
         out["slip"] = g.slip
@@ -235,24 +238,25 @@ class Twin:
             out[moving_key] = abs(axis.velocity) > moving
             out[effort_key] = axis.effort
         fingers = g.fingers
-        for name, contact_key, force_key, status_key in self._finger_keys:
-            finger = fingers[name]
-            out[contact_key] = bool(finger.contacts)
-            out[force_key] = finger.force
-            out[status_key] = finger.status
+        if fingers is not self._published_fingers:  # (the gripper keeps its fingers' states while they stand)
+            for name, contact_key, force_key, status_key in self._finger_keys:
+                finger = fingers[name]
+                out[contact_key] = bool(finger.contacts)
+                out[force_key] = finger.force
+                out[status_key] = finger.status
+            self._published_fingers = fingers
         arm = None
         if self.robot is not None:
             out["robot.busy"] = self.robot.busy(self.time)
             arm = [s[0] for s in arm_states] if arm_states else self.robot.positions()
-            for key, q in zip(self._robot_keys, arm):
-                out[key] = q
+            out.update(zip(self._robot_keys, arm))
         pose = self.world.client.getBasePositionAndOrientation
         poses = []
         for uid, x_key, y_key, z_key in self._target_keys:
             p = pose(uid)
             poses.append(p)
             out[x_key], out[y_key], out[z_key] = p[0]
-        self._outputs = out
+        self._outputs = self._published = out
         self._read = (self.step_count, arm, self.gripper.step_positions, poses)
 
     def step_readings(self) -> tuple[list[int], list[float], list[int], list[tuple]] | None:
