@@ -134,6 +134,15 @@ class Drive:
     mass: float = 0.0  # kg (kg m^2 for a revolute drive): what it moves, with the lightest target
     limit: float = float("inf")  # the stiffest spring the step keeps stable for that mass (N/m or N m/rad)
     own: float = 0.0  # kg (kg m^2): its own links' and mimic followers' share of `mass` (without the part)
+    # (derived, for every physics substep: the full-force error, stiffer than the step resolves, the holding force)
+    full: float = field(init=False, repr=False, compare=False)
+    rigid: bool = field(init=False, repr=False, compare=False)
+    hold: float = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "full", self.effort / self.stiffness)
+        object.__setattr__(self, "rigid", self.stiffness > self.limit)
+        object.__setattr__(self, "hold", HOLD_FRACTION * self.effort)
 
     @property
     def full_error(self) -> float:
@@ -557,7 +566,7 @@ class Gripper:
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
-            full = d.effort / d.stiffness
+            full = d.full
             if before == g and not pressing and name not in turned and stalled.get(name) is None:
                 # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the ramp
                 # below gives, in short: the goal itself, within full force of the joint unless others press through it
@@ -607,7 +616,7 @@ class Gripper:
             error = target - actual
             toward = joint_speed if error > 0.0 else -joint_speed
             speed = error / h  # to be at the command after the substep, as far as the force allows
-            rigid = d.stiffness > d.limit  # stiffer than the step resolves (a station's choice): rigid up to its effort
+            rigid = d.rigid  # stiffer than the step resolves (a station's choice): rigid up to its effort
             leaning = False
             if pressing and name in loads:
                 if target != g:  # pressing through drives in series: leaning on those that stand at their goals
@@ -660,9 +669,9 @@ class Gripper:
             if rigid:
                 forces.append(effort)
             else:
-                forces.append(min(effort, abs(d.stiffness * error - d.damping * joint_speed) + HOLD_FRACTION * d.effort))
+                forces.append(min(effort, abs(d.stiffness * error - d.damping * joint_speed) + d.hold))
             quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
-                     and d.stiffness * abs(error) <= HOLD_FRACTION * d.effort)  # a pressing drive: every substep
+                     and d.stiffness * abs(error) <= d.hold)  # a pressing drive: every substep
         self._quiet = quiet
         self._holding = now_holding
         if quiet and substep == 0 and self.substeps > 1:  # these settings hold for the whole step: the small error
@@ -797,8 +806,9 @@ class Gripper:
             force = sum(on.values())
             fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
         self.state.fingers = fingers
-        self._presses = {name: any(fingers[f].force > 0.0 for f in fs) for name, fs in self._fingers_of_servo.items()}
-        self.pressing = any(f.force > 0.0 for f in fingers.values())  # a finger pressed on a part in this step
+        pressed = {f for f, state in fingers.items() if state.force > 0.0}
+        self._presses = {name: not pressed.isdisjoint(fs) for name, fs in self._fingers_of_servo.items()}
+        self.pressing = bool(pressed)  # a finger pressed on a part in this step
         self._reset_sums()
         self._grip_rule()
 

@@ -128,7 +128,8 @@ class Twin:
         for _ in range(n):
             for device in self.devices:
                 device.before_step(self)
-            self._place_targets()
+            if self._present != self._placed:  # (a `TARGET.present` written since: applied now)
+                self._place_targets()
             # the drives and the arm are commanded at every physics substep: an arm command held for a whole
             # step moves the flange in bursts that shake a friction grip loose (measured-facts.md)
             t, h, gripper, robot, world = self.time, self.world.substep, self.gripper, self.robot, self.world
