@@ -39,6 +39,7 @@ class TwinBridge:
         # changed (most do not from one step to the next) into them
         self._buffers = {t: bytearray(size if t in BIT_TABLES else 2 * size) for t, size in self._sizes.items()}
         self._last = {t: [_UNSET] * len(entries) for t, entries in self._keyed.items()}
+        self._bytes = {t: bytes(b) for t, b in self._buffers.items()}  # each image as last built from its buffer
         self._bits = {t: [(e.address, key) for e, key in self._keyed[t]] for t in BIT_TABLES}
         self.images: Images = Images(b"", b"", b"", b"")
         self.publish(exchange.snapshot)
@@ -112,17 +113,25 @@ class TwinBridge:
         for table, entries in self._keyed.items():
             buf, last = self._buffers[table], self._last[table]
             if table in BIT_TABLES:
-                for address, key in self._bits[table]:
-                    buf[address] = 1 if get(key, 0) else 0
-            else:
-                for i, (e, key) in enumerate(entries):
-                    v = crc if key == MAP_CRC else get(key, 0)
+                bits = [1 if get(key, 0) else 0 for _, key in self._bits[table]]
+                if bits != last:  # unchanged bits (most steps): the image as it was
+                    last[:] = bits
+                    for (address, _), bit in zip(self._bits[table], bits):
+                        buf[address] = bit
+                    self._bytes[table] = bytes(buf)
+                images[table] = self._bytes[table]
+                continue
+            new = [crc if key == MAP_CRC else get(key, 0) for _, key in entries]
+            if new != last:  # equal lists: the same values, the image as it was (a changed type packs the same words)
+                for i, v in enumerate(new):
                     old = last[i]
                     if old is v or (old == v and type(old) is type(v)):
                         continue
                     last[i] = v
+                    e = entries[i][0]
                     e.pack_into(buf, 2 * e.address, v)
-            images[table] = bytes(buf)
+                self._bytes[table] = bytes(buf)
+            images[table] = self._bytes[table]
         self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
         for batch in self.exchange.pending:  # written but not yet applied (empty after a step): still reads as written
             self._show_written(batch)

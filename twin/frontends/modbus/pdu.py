@@ -247,6 +247,7 @@ class PduHandler:
         self.read_only, self.gaps_zero = read_only, gaps_zero
         self.tables = {t: _Table(rmap, t, gaps_zero) for t in TABLES}
         self.layout = ImageLayout({t: self.tables[t].size for t in TABLES})
+        self._plans: dict[tuple[int, int], list] = {}  # (window start, words) -> the entries a write covers
         self._in_cache: tuple[object, bytes] | None = None
         self.identity = identity or DeviceIdentity()
         self.id_objects = self.identity.objects()
@@ -380,16 +381,12 @@ class PduHandler:
         self._in_cache = (key, window)
         return window
 
-    def _write_window(self, address: int, words: Sequence[int]) -> int:
-        """A write into the output window: the entries it covers, all or nothing (see ImageLayout)."""
+    def _window_plan(self, start: int, end: int) -> list:
+        """The output window's words start..end as (offset, table, address, entry), in address order, with
+        (offset, None, code, None) where a write of them must stop with exception `code` (part of an entry)."""
         lay = self.layout
-        start = address - IMAGE_OUT
-        if address < IMAGE_OUT or start + len(words) > lay.out_size:
-            return ILLEGAL_DATA_ADDRESS
-        changes = []
-        images = self.backend.images
-        current_h = None
-        k, end = start, start + len(words)
+        plan = []
+        k = start
         while k < end:
             if k < lay.out_offset[HOLDING_REGISTER]:
                 table, a = COIL, k
@@ -399,20 +396,43 @@ class PduHandler:
             e = t.entry_at.get(a)
             if e is None:
                 if t.valid[a]:  # inside an entry that starts before the write: only part of it
-                    return ILLEGAL_DATA_ADDRESS
+                    plan.append((k - start, None, ILLEGAL_DATA_ADDRESS, None))
+                    break
                 k += 1  # an unmapped address: ignored
                 continue
             if k + e.count > end:
-                return ILLEGAL_DATA_ADDRESS
-            chunk = tuple(words[k - start:k - start + e.count])
+                plan.append((k - start, None, ILLEGAL_DATA_ADDRESS, None))
+                break
+            plan.append((k - start, table, a, e))
+            k += e.count
+        return plan
+
+    def _write_window(self, address: int, words: Sequence[int]) -> int:
+        """A write into the output window: the entries it covers, all or nothing (see ImageLayout)."""
+        start = address - IMAGE_OUT
+        if address < IMAGE_OUT or start + len(words) > self.layout.out_size:
+            return ILLEGAL_DATA_ADDRESS
+        key = (start, len(words))
+        plan = self._plans.get(key)
+        if plan is None:
+            plan = self._plans[key] = self._window_plan(start, start + len(words))
+        changes = []
+        images = self.backend.images
+        current_h = None
+        for off, table, a, e in plan:
+            if table is None:
+                return a
+            count = e.count
+            chunk = tuple(words[off:off + count])
             if table == COIL:
                 if chunk[0] not in (0, 1):
                     return ILLEGAL_DATA_VALUE
                 same = images.coils[a] == chunk[0]
             else:
                 if current_h is None:
-                    current_h = _patched(self.backend, images.holding)
-                same = current_h[2 * a:2 * a + 2 * e.count] == struct.pack(f">{e.count}H", *chunk)
+                    h = _patched(self.backend, images.holding)
+                    current_h = struct.unpack(f">{len(h) // 2}H", h)
+                same = current_h[a:a + count] == chunk
             if not e.writable:
                 if not same:
                     return ILLEGAL_DATA_ADDRESS
@@ -422,7 +442,6 @@ class PduHandler:
                 if value is None:
                     return ILLEGAL_DATA_VALUE
                 changes.append((e, value))
-            k += e.count
         return self.backend.submit(changes) if changes else 0
 
     # -- writes ---------------------------------------------------------------------------------------
