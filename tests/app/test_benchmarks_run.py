@@ -1,6 +1,6 @@
 """Every benchmark of `bench/` runs with tiny parameters, so none can rot (a renamed attribute, a changed event,
 a moved module fail here, not in the hands of whoever measures next). Their figures are the benchmarks' business;
-here only that each runs to its end and prints what it compares. `st`, `record`, `load` and `adapter` have
+here only that each runs to its end and prints what it compares (a missed target, exit 1, is no failure here). `st`, `record`, `load` and `adapter` have
 theirs beside their subjects (tests/structured_text, tests/app/test_bench_record.py, test_bench_load.py,
 test_frontend_process.py)."""
 from __future__ import annotations
@@ -38,5 +38,6 @@ def test_the_benchmark_runs_with_tiny_parameters(name):
     args, says = TINY[name]
     run = subprocess.run([sys.executable, "-m", "bench", name, *args], cwd=ROOT, capture_output=True, text=True,
                          timeout=240)
-    assert run.returncode == 0, run.stderr[-3000:]
+    # a benchmark may exit 1 for a missed target (tiny runs are noise); it must not crash
+    assert run.returncode in (0, 1) and "Traceback" not in run.stderr, run.stderr[-3000:]
     assert says in run.stdout, run.stdout[-3000:]
