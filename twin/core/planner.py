@@ -334,6 +334,32 @@ class PathClock:
             self._to(t, 1.0, ramp)
 
 
+def stop_on_path(kin, queue: "MotionQueue", clock: "PathClock", t: float, quick: bool, at_end: bool) -> None:
+    """StopMove on a running path (robot.Robot and KinematicRobot alike): decelerate along it (`quick`: at the axes'
+    full acceleration limits, else half), or with `at_end` stand at the end of the motion under way."""
+    tau = clock.tau(t)
+    if at_end:
+        seg = next((s for s in queue.segments if s.start <= tau < s.end), None)
+        clock.stop(clock.t_of(seg.end) if seg is not None else t, 0.0)
+    else:
+        clock.stop(t, stop_ramp(kin, queue.state(tau)[1], quick))
+
+
+def restart_on_path(kin, queue: "MotionQueue", clock: "PathClock", t: float) -> None:
+    """StartMove: the rest of a stopped path, speeding up as it slowed down."""
+    clock.start(t, stop_ramp(kin, queue.state(clock.tau(t))[1], False))
+
+
+def stand_time(standing: bool, clock: "PathClock | None", t: float) -> float | None:
+    """When a path will stand: t if it does (or the robot is idle), the end of its stop ramp while it stops, None
+    if it is not stopping."""
+    if standing:
+        return t
+    if clock is not None and clock.stopping:
+        return clock.t_a + clock.ramp
+    return None
+
+
 def stop_ramp(kin, qd: np.ndarray, quick: bool) -> float:
     """How long (s) a StopMove takes to bring the clock's rate from 1 to 0 as a half cosine when the axes move at
     qd: the rate's steepest fall (pi / 2 / ramp) times each axis's speed at most its acceleration limit (\\Quick)
@@ -455,29 +481,18 @@ class KinematicRobot:
 
     # -- path control, as robot.Robot's --------------------------------------------------------------------
     def stop_path(self, t: float, quick: bool = False, at_end: bool = False) -> None:
-        if not self.busy(t):
-            return
-        tau = self._tau(t)
-        if at_end:
-            seg = next((s for s in self._queue.segments if s.start <= tau < s.end), None)
-            self._clock.stop(self._clock.t_of(seg.end) if seg is not None else t, 0.0)
-        else:
-            self._clock.stop(t, stop_ramp(self.kinematics, self._queue.state(tau)[1], quick))
+        if self.busy(t):
+            stop_on_path(self.kinematics, self._queue, self._clock, t, quick, at_end)
 
     def path_standing(self, t: float) -> bool:
         return not self.busy(t) or (self._clock.stopping and self._clock.rate(t) == 0.0)
 
     def stand_time(self, t: float) -> float | None:
-        """When the path will stand (t if it does or the robot is idle), None if not stopping."""
-        if self.path_standing(t):
-            return t
-        if self._clock is not None and self._clock.stopping:
-            return self._clock.t_a + self._clock.ramp
-        return None
+        return stand_time(self.path_standing(t), self._clock, t)
 
     def start_path(self, t: float) -> None:
         if self._queue is not None and self._clock.stopping:
-            self._clock.start(t, stop_ramp(self.kinematics, self._queue.state(self._tau(t))[1], False))
+            restart_on_path(self.kinematics, self._queue, self._clock, t)
 
     def _stand(self, t: float) -> np.ndarray:
         q = self.q_at(t)

@@ -22,7 +22,8 @@ from .errors import MotionError
 from .geometry import Pose
 from .kinematics import ARM_JOINTS, ArmKinematics
 from .motion import Trajectory
-from .planner import FINE, REGAIN_DISTANCE, MotionQueue, PathClock, Zone, stop_ramp
+from .planner import (FINE, REGAIN_DISTANCE, MotionQueue, PathClock, Zone, restart_on_path, stand_time,
+                      stop_on_path)
 
 
 class Robot:
@@ -204,14 +205,8 @@ class Robot:
     def stop_path(self, t: float, quick: bool = False, at_end: bool = False) -> None:
         """StopMove: decelerate on the planned path and stand (planner.PathClock; `quick`: at the axes' full
         acceleration limits, else half). `at_end`: stand at the end of the motion under way instead."""
-        if self._queue is None or self._clock is None or not self.busy(t):
-            return
-        tau = self._clock.tau(t)
-        if at_end:
-            seg = next((s for s in self._queue.segments if s.start <= tau < s.end), None)
-            self._clock.stop(self._clock.t_of(seg.end) if seg is not None else t, 0.0)
-        else:
-            self._clock.stop(t, stop_ramp(self.kinematics, self._queue.state(tau)[1], quick))
+        if self._queue is not None and self._clock is not None and self.busy(t):
+            stop_on_path(self.kinematics, self._queue, self._clock, t, quick, at_end)
 
     def path_standing(self, t: float) -> bool:
         """Is the robot standing still on its path (stopped by `stop_path`, the ramp over) or idle?"""
@@ -221,17 +216,12 @@ class Robot:
 
     def stand_time(self, t: float) -> float | None:
         """When the path will stand (t if it does or the robot is idle), None if not stopping."""
-        if self.path_standing(t):
-            return t
-        if self._clock is not None and self._clock.stopping:
-            return self._clock.t_a + self._clock.ramp
-        return None
+        return stand_time(self.path_standing(t), self._clock, t)
 
     def start_path(self, t: float) -> None:
         """StartMove: the rest of the stopped path, speeding up as it slowed down."""
         if self._queue is not None and self._clock is not None and self._clock.stopping:
-            tau = self._clock.tau(t)
-            self._clock.start(t, stop_ramp(self.kinematics, self._queue.state(tau)[1], False))
+            restart_on_path(self.kinematics, self._queue, self._clock, t)
 
     def _stand(self, t: float) -> np.ndarray:
         """Where the path stands at t (its planned joints), the robot then idle there with no path."""
