@@ -82,16 +82,23 @@ def newcomer_station(folder, effort: float, extra: str = ""):
     """The gripper fixed above a steel block on the floor; not `always_active`, as a newcomer leaves it."""
     folder.mkdir()
     two_finger_urdf(folder / "gripper.urdf", effort)
+    (folder / "station.toml").write_text(block_station_toml("newcomer", "initial = { jaw_a = 0.035, jaw_b = 0.035 }",
+                                                            extra))
+    return folder
+
+
+def block_station_toml(name: str, gripper: str, extra: str = "") -> str:
+    """A station file: gripper.urdf fixed upside down with the palm's underside 15 mm above a steel BLOCK on the
+    floor (the 50 mm fingers reach 5 mm above it); `gripper` adds lines to its [gripper] table, `extra` tables."""
     sx, sy, sz = BLOCK
-    # the palm's underside 15 mm above the part: the 50 mm fingers reach 5 mm above the floor
-    (folder / "station.toml").write_text(f"""[station]
-name = "newcomer"
+    return f"""[station]
+name = "{name}"
 
 [gripper]
 urdf = "gripper.urdf"
 mount = {{ xyz = [0.0, 0.0, {sz + 0.015}], rpy_deg = [180.0, 0.0, 0.0] }}
 friction = {FINGER_FRICTION}
-initial = {{ jaw_a = 0.035, jaw_b = 0.035 }}
+{gripper}
 {extra}
 
 [[targets]]
@@ -105,8 +112,7 @@ friction = {PART_FRICTION}
 [[fixtures]]
 name = "floor"
 shape = "plane"
-""")
-    return folder
+"""
 
 
 @pytest.mark.parametrize("effort", [0.5, 40.0])
@@ -734,30 +740,9 @@ def series_station(folder, slide: float, fine: float, fine_stiffness: float | No
   </link>
 </robot>
 """)
-    sx, sy, sz = BLOCK
     stiff = "" if fine_stiffness is None else f"[gripper.joints.fine_b]\nstiffness = {fine_stiffness}\n"
-    (folder / "station.toml").write_text(f"""[station]
-name = "series"
-
-[gripper]
-urdf = "gripper.urdf"
-mount = {{ xyz = [0.0, 0.0, {sz + 0.015}], rpy_deg = [180.0, 0.0, 0.0] }}
-always_active = true
-friction = {FINGER_FRICTION}
-initial = {{ jaw_a = 0.035, slide_b = 0.035, fine_b = 0.0 }}
-{stiff}
-[[targets]]
-name = "block"
-shape = "box"
-size = [{sx}, {sy}, {sz}]
-xyz = [0.0, 0.0, {sz / 2}]
-density = {DENSITY}
-friction = {PART_FRICTION}
-
-[[fixtures]]
-name = "floor"
-shape = "plane"
-""")
+    (folder / "station.toml").write_text(block_station_toml(
+        "series", "always_active = true\ninitial = { jaw_a = 0.035, slide_b = 0.035, fine_b = 0.0 }", stiff))
     return folder
 
 
