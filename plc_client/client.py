@@ -120,10 +120,16 @@ class WindowImage:
         self.client, self.words = client, words
         self.layout = client.layout
 
+    @staticmethod
+    def slot(layout, s: Signal) -> tuple[int, int, int]:
+        """(first word, words, bit) of a signal in the input window; bit -1 for a register value."""
+        k, n = layout.in_words(s)
+        return k, n, s.address % 16 if s.table in BIT_TABLES else -1
+
     def value(self, s: Signal) -> Any:
-        k, n = self.layout.in_words(s)
-        if s.table in BIT_TABLES:
-            return decode(s, [(self.words[k] >> (s.address % 16)) & 1])
+        k, n, bit = self.slot(self.layout, s)
+        if bit >= 0:
+            return decode(s, [(self.words[k] >> bit) & 1])
         return decode(s, self.words[k:k + n])
 
     def out_word(self, k: int) -> int:
@@ -623,7 +629,8 @@ class ClientIO(LocalSignals):
         self._image: WindowImage | None = None  # the input window as last read
         self._fresh = False  # it shows the process as it is now (lockstep: read after the last steps)
         self._pending: dict[str, Any] = {}  # lockstep: outputs to write with the next advance (checked)
-        self._reads: dict[tuple, list[Signal]] = {}  # the names a scan reads -> their entries (checked once)
+        self._reads: dict[tuple, list[tuple]] = {}  # the names a scan reads -> where each sits in the window
+        self._decoded: dict[str, tuple] = {}  # name -> (its words or bit as last read, their value)
 
     def _read(self, names: list[str]) -> dict[str, Any]:
         if not names:
@@ -631,14 +638,24 @@ class ClientIO(LocalSignals):
         if not self.exchange:
             return self.client.read(*names)
         key = tuple(names)
-        signals = self._reads.get(key)
-        if signals is None:
-            signals = self._reads[key] = check_names(self.client.map, names)
+        slots = self._reads.get(key)
+        if slots is None:
+            slots = self._reads[key] = [(s.name, s, *WindowImage.slot(self.client.layout, s))
+                                        for s in check_names(self.client.map, names)]
         if not self._fresh or self._image is None:
             self._image = self.client.read_window()
         self._fresh = self.lockstep  # real time: the next scan reads anew; lockstep: until the next advance
-        value = self._image.value
-        return {s.name: value(s) for s in signals}
+        words, decoded = self._image.words, self._decoded
+        out = {}
+        for name, s, k, n, bit in slots:  # a value whose words did not change since the last read is not decoded again
+            raw = (words[k] >> bit) & 1 if bit >= 0 else words[k] if n == 1 else tuple(words[k:k + n])
+            last = decoded.get(name)
+            if last is not None and last[0] == raw:
+                out[name] = last[1]
+            else:
+                out[name] = value = decode(s, [raw] if bit >= 0 else words[k:k + n])
+                decoded[name] = (raw, value)
+        return out
 
     def _write(self, values: dict[str, Any]) -> None:
         if not self.exchange:

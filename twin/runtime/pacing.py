@@ -146,7 +146,10 @@ class LockstepRunner:
     """Step only on request (`request(n)`), as fast as possible, yielding to the server between slices of steps.
 
     It runs as plain callbacks of the event loop (`call_soon`), not as a task woken through an event: a request
-    costs one turn of the loop before its steps, and the answer waiting for them goes out from the last one."""
+    costs one turn of the loop before its steps, and the answer waiting for them goes out from the last one.
+    A server answering requests holds the runner meanwhile (`hold`) and releases it at the end of its turn
+    (`release`), which runs the steps asked for at once: a turn of the loop in between would only poll the
+    sockets again."""
 
     mode = "lockstep"
     speed = 0.0
@@ -163,10 +166,22 @@ class LockstepRunner:
         self._finished: asyncio.Future | None = None  # `run()` waits on it: stopped, or the simulation failed
         self._stop = False
         self.failed = False
+        self._held = False
 
     @property
     def remaining(self) -> int:
         return self.target - self.steps
+
+    def hold(self) -> None:
+        """Steps asked for from now wait for `release()` (from the loop's thread, in the same turn of the loop)."""
+        self._held = True
+
+    def release(self) -> None:
+        """End `hold()`: the steps asked for meanwhile run now (a slice; the rest in later turns of the loop)."""
+        if self._held:
+            self._held = False
+            if self._loop is not None and not self._scheduled and not self._stop and self.steps < self.target:
+                self._slice()
 
     def request(self, n: int) -> None:
         if self.failed:
@@ -187,7 +202,7 @@ class LockstepRunner:
             callback()
 
     def _schedule(self) -> None:
-        if self._loop is not None and not self._scheduled and not self._stop and self.steps < self.target:
+        if self._loop is not None and not self._held and not self._scheduled and not self._stop and self.steps < self.target:
             self._scheduled = True
             self._loop.call_soon(self._slice)
 

@@ -13,8 +13,8 @@ can undo that.
 """
 from __future__ import annotations
 
-import struct
 from collections.abc import Sequence
+from operator import itemgetter
 
 from twin.core.errors import SignalError, TwinError
 from twin.runtime.exchange import Exchange, SimulationFault, Snapshot
@@ -38,9 +38,21 @@ class TwinBridge:
         # the images as of the last snapshot, kept between publishes: a publish re-encodes only the values that
         # changed (most do not from one step to the next) into them
         self._buffers = {t: bytearray(size if t in BIT_TABLES else 2 * size) for t, size in self._sizes.items()}
-        self._last = {t: [_UNSET] * len(entries) for t, entries in self._keyed.items()}
+        self._last = {t: (_UNSET,) * len(entries) for t, entries in self._keyed.items()}
         self._bytes = {t: bytes(b) for t, b in self._buffers.items()}  # each image as last built from its buffer
-        self._bits = {t: [(e.address, key) for e, key in self._keyed[t]] for t in BIT_TABLES}
+        # per table: its values taken from a snapshot in one call, and how each is written into the image
+        values = exchange.snapshot.values
+        self._tables = []
+        for t, entries in self._keyed.items():
+            keys = tuple(key for _, key in entries)
+            take = (_taker(keys) if all(k in values for k in keys)
+                    else (lambda v, keys=keys: tuple(v.get(k, 0) for k in keys)))
+            crc_at = keys.index(MAP_CRC) if MAP_CRC in keys and t not in BIT_TABLES else None
+            if t in BIT_TABLES:
+                writers = tuple(e.address for e, _ in entries)
+            else:
+                writers = tuple((e._packer.pack_into, 2 * e.address, e.counter) for e, _ in entries)
+            self._tables.append((t, take, crc_at, t in BIT_TABLES, writers))
         self.images: Images = Images(b"", b"", b"", b"")
         self.publish(exchange.snapshot)
         self._unsubscribe = exchange.subscribe(on_snapshot=self.publish, on_writes=self._show_written)
@@ -78,6 +90,18 @@ class TwinBridge:
         else:
             self.exchange.runner.when_done(callback)
 
+    def hold_steps(self) -> None:
+        """A turn of answering starts: lockstep steps asked for in it wait for `run_steps` (`LockstepRunner.hold`)."""
+        runner = self.exchange.runner
+        if runner is not None and runner.mode == "lockstep":
+            runner.hold()
+
+    def run_steps(self) -> None:
+        """The turn is over: the lockstep steps asked for in it run now."""
+        runner = self.exchange.runner
+        if runner is not None and runner.mode == "lockstep":
+            runner.release()
+
     def live_holding(self, address: int) -> int | None:
         if self._advance is not None and address == self._advance.address:
             runner = self.exchange.runner
@@ -106,35 +130,42 @@ class TwinBridge:
                                  old.holding if holding is None else bytes(holding), old.input_registers)
 
     def publish(self, snapshot: Snapshot | None = None) -> None:
-        """New images from a snapshot (default: the exchange's latest), with the writes still queued on top."""
+        """New images from a snapshot (default: the exchange's latest), with the writes still queued on top.
+        Only the values that changed since the last snapshot are encoded (most do not from one step to the next)."""
         values = (snapshot or self.exchange.snapshot).values
-        get, crc = values.get, self.crc
-        images = {}
-        for table, entries in self._keyed.items():
-            buf, last = self._buffers[table], self._last[table]
-            if table in BIT_TABLES:
-                bits = [1 if get(key, 0) else 0 for _, key in self._bits[table]]
-                if bits != last:  # unchanged bits (most steps): the image as it was
-                    last[:] = bits
-                    for (address, _), bit in zip(self._bits[table], bits):
-                        buf[address] = bit
-                    self._bytes[table] = bytes(buf)
-                images[table] = self._bytes[table]
+        buffers, lasts, images = self._buffers, self._last, self._bytes
+        for table, take, crc_at, bits, writers in self._tables:
+            new = take(values)
+            if crc_at is not None:
+                new = (*new[:crc_at], self.crc, *new[crc_at + 1:])
+            last = lasts[table]
+            if new == last:  # the same values: the image as it was
                 continue
-            new = [crc if key == MAP_CRC else get(key, 0) for _, key in entries]
-            if new != last:  # equal lists: the same values, the image as it was (a changed type packs the same words)
-                for i, v in enumerate(new):
-                    old = last[i]
+            buf = buffers[table]
+            if bits:
+                for address, v in zip(writers, new):
+                    buf[address] = 1 if v else 0
+            else:
+                for old, v, (pack_into, offset, counter) in zip(last, new, writers):
+                    # equal values of the same type pack the same words (a changed type, e.g. 1 for 1.0, is packed)
                     if old is v or (old == v and type(old) is type(v)):
                         continue
-                    last[i] = v
-                    e = entries[i][0]
-                    e.pack_into(buf, 2 * e.address, v)
-                self._bytes[table] = bytes(buf)
-            images[table] = self._bytes[table]
+                    pack_into(buf, offset, counter(v))
+            lasts[table] = new
+            images[table] = bytes(buf)
         self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
         for batch in self.exchange.pending:  # written but not yet applied (empty after a step): still reads as written
             self._show_written(batch)
+
+
+def _taker(keys: tuple[str, ...]):
+    """mapping -> the values of `keys` as a tuple, in one call."""
+    if len(keys) == 1:
+        key = keys[0]
+        return lambda values: (values[key],)
+    if not keys:
+        return lambda values: ()
+    return itemgetter(*keys)
 
 
 _UNSET = object()  # no value encoded yet

@@ -14,6 +14,7 @@ read (the next poll), asks for steps or waits for them (writes or reads `sim.adv
 """
 from __future__ import annotations
 
+import functools
 import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -61,6 +62,9 @@ class Backend(Protocol):
 
     def when_stepped(self, callback) -> None:
         """Call `callback()` once the steps asked for are done (at once if none are left)."""
+
+    # optional: `hold_steps()` as a turn of answering starts and `run_steps()` when it ends (steps asked for in
+    # the turn run then, not a turn of the event loop later; `TwinBridge`'s)
 
 
 # -- device identification (6.21) ---------------------------------------------------------------------
@@ -218,6 +222,12 @@ class _Table:
 _ASCII_BITS = bytes.maketrans(b"\x00\x01", b"01")
 
 
+@functools.lru_cache(maxsize=None)
+def _words(n: int) -> struct.Struct:
+    """n big-endian 16-bit words."""
+    return struct.Struct(f">{n}H")
+
+
 def _patched(backend, holding: bytes) -> bytes:
     """The holding-register image with its live registers (sim.advance) filled in."""
     out = bytearray(holding)
@@ -226,6 +236,14 @@ def _patched(backend, holding: bytes) -> bytes:
         if v is not None and 2 * a + 2 <= len(out):
             struct.pack_into(">H", out, 2 * a, v)
     return bytes(out)
+
+
+def pack_words(bits: bytes, words: int) -> bytes:
+    """Bytes of 0/1 -> `words` big-endian words, bit i of word k being bit 16k + i (the input window's packing)."""
+    data = pack_bits(bits).ljust(2 * words, b"\x00")[:2 * words]
+    swapped = bytearray(data)
+    swapped[0::2], swapped[1::2] = data[1::2], data[0::2]
+    return bytes(swapped)
 
 
 def pack_bits(bits: bytes) -> bytes:
@@ -249,6 +267,8 @@ class PduHandler:
         self.layout = ImageLayout({t: self.tables[t].size for t in TABLES})
         self._plans: dict[tuple[int, int], list] = {}  # (window start, words) -> the entries a write covers
         self._in_cache: tuple[object, bytes] | None = None
+        self._holding_cache: tuple | None = None  # (holding image, live words, the words as they read)
+        self._in_parts: dict[str, tuple[bytes, bytes]] = {}  # table -> (its image, packed into the input window)
         self.identity = identity or DeviceIdentity()
         self.id_objects = self.identity.objects()
         self.requests = 0
@@ -370,14 +390,16 @@ class PduHandler:
         if self._in_cache is not None and self._in_cache[0] == key:
             return self._in_cache[1]
         lay = self.layout
-
-        def packed(bits: bytes, words: int) -> bytes:
-            data = pack_bits(bits).ljust(2 * words, b"\x00")
-            return b"".join(data[i + 1:i + 2] + data[i:i + 1] for i in range(0, 2 * words, 2))  # word k: bits 16k..16k+15
-
-        holding = _patched(self.backend, images.holding)
-        window = (packed(images.discrete_inputs, lay.in_offset[INPUT_REGISTER]) + images.input_registers
-                  + packed(images.coils, lay.in_offset[HOLDING_REGISTER] - lay.in_offset[COIL]) + holding)
+        parts = self._in_parts  # each table's part as last packed, kept while its image stays the same object
+        di = parts.get(DISCRETE_INPUT)
+        if di is None or di[0] is not images.discrete_inputs:
+            di = parts[DISCRETE_INPUT] = (images.discrete_inputs,
+                                          pack_words(images.discrete_inputs, lay.in_offset[INPUT_REGISTER]))
+        coils = parts.get(COIL)
+        if coils is None or coils[0] is not images.coils:
+            coils = parts[COIL] = (images.coils,
+                                   pack_words(images.coils, lay.in_offset[HOLDING_REGISTER] - lay.in_offset[COIL]))
+        window = di[1] + images.input_registers + coils[1] + _patched(self.backend, images.holding)
         self._in_cache = (key, window)
         return window
 
@@ -407,6 +429,18 @@ class PduHandler:
             k += e.count
         return plan
 
+    def _holding_words(self, holding: bytes) -> tuple[int, ...]:
+        """The holding registers' words as they read now (the live ones filled in), kept while they stay so."""
+        backend = self.backend
+        live = tuple(backend.live_holding(a) for a in backend.live_addresses)
+        cached = self._holding_cache
+        if cached is not None and cached[0] is holding and cached[1] == live:
+            return cached[2]
+        h = _patched(backend, holding)
+        words = _words(len(h) // 2).unpack(h)
+        self._holding_cache = (holding, live, words)
+        return words
+
     def _write_window(self, address: int, words: Sequence[int]) -> int:
         """A write into the output window: the entries it covers, all or nothing (see ImageLayout)."""
         start = address - IMAGE_OUT
@@ -430,8 +464,7 @@ class PduHandler:
                 same = images.coils[a] == chunk[0]
             else:
                 if current_h is None:
-                    h = _patched(self.backend, images.holding)
-                    current_h = struct.unpack(f">{len(h) // 2}H", h)
+                    current_h = self._holding_words(images.holding)
                 same = current_h[a:a + count] == chunk
             if not e.writable:
                 if not same:
@@ -445,9 +478,11 @@ class PduHandler:
         return self.backend.submit(changes) if changes else 0
 
     # -- writes ---------------------------------------------------------------------------------------
-    def _write(self, table: str, address: int, words: Sequence[int]) -> int:
-        """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code."""
-        if self.hold is not None and table == HOLDING_REGISTER and self._advances(address, words):
+    def _write(self, table: str, address: int, words: Sequence[int], advances: bool | None = None) -> int:
+        """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code. `advances`:
+        whether it sets sim.advance, when known (`_advances`)."""
+        if (self.hold is not None and table == HOLDING_REGISTER
+                and (self._advances(address, words) if advances is None else advances)):
             self.hold.release()  # the client asked for steps: its next read is of them
         if table == HOLDING_REGISTER and address >= IMAGE_OUT:
             return self._write_window(address, words)
@@ -498,7 +533,7 @@ class PduHandler:
         nbytes = pdu[5]
         if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(pdu) != 6 + nbytes:
             return ILLEGAL_DATA_VALUE
-        words = struct.unpack_from(f">{count}H", pdu, 6)
+        words = _words(count).unpack_from(pdu, 6)
         return self._write(HOLDING_REGISTER, address, words) or pdu[:5]
 
     def _mask_write_register(self, pdu: bytes):
@@ -526,8 +561,9 @@ class PduHandler:
         if raddr >= IMAGE_IN and not self._window_fits(raddr, rcount):
             return ILLEGAL_DATA_ADDRESS
         # The spec's order: the write first, then the read (which sees the write).
-        words = struct.unpack_from(f">{wcount}H", pdu, 10)
-        code = self._write(HOLDING_REGISTER, waddr, words)
+        words = _words(wcount).unpack_from(pdu, 10)
+        advances = self._advances(waddr, words)
+        code = self._write(HOLDING_REGISTER, waddr, words, advances)
         if code:
             return code
 
@@ -535,7 +571,7 @@ class PduHandler:
             data = self.registers(HOLDING_REGISTER, raddr, rcount)
             return bytes((23, len(data))) + data
 
-        if self._advances(waddr, words) and self.backend.stepping():
+        if advances and self.backend.stepping():
             return Deferred(read)  # lockstep: the read sees the state after the steps asked for
         return read()
 

@@ -51,7 +51,7 @@ import json
 import math
 import struct
 import zlib
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -164,22 +164,43 @@ class Entry:
     def counts_of(self, value, *, engineering: bool = False) -> int | float:
         """SI value (as the twin reads it) -> counts (an output saturated at its declared range, anything at its
         type's limits). `engineering`: the value is in the entry's `unit` already (mm, deg: as a PLC holds it)."""
-        factor = 1.0 if engineering else self.factor
+        return (self.engineering_counter if engineering else self.counter)(value)
+
+    @cached_property
+    def counter(self) -> Callable[[Any], int | float]:
+        """`counts_of` for an SI value, as one function of the value (the server encodes every changed output at
+        every step)."""
+        return self._counter(self.factor)
+
+    @cached_property
+    def engineering_counter(self) -> Callable[[Any], int | float]:
+        return self._counter(1.0)
+
+    def _counter(self, factor: float) -> Callable[[Any], int | float]:
+        """The rule of `counts_of` for values `factor` times the SI value: bits 0/1, an enumeration's index
+        (its text, or the index itself), a float32's value, else the value in counts, rounded and saturated
+        (`_saturation`; NaN is 0). A bool is the number 0 or 1."""
         if self.type == "bool":
-            return 1 if value else 0
+            return lambda value: 1 if value else 0
         if self.choices:
-            if isinstance(value, int) and not isinstance(value, bool):
-                return value
-            return self.choices.index(value) if value in self.choices else 0
-        if isinstance(value, bool):
-            value = int(value)
+            choices = self.choices
+
+            def index(value):
+                if isinstance(value, int) and not isinstance(value, bool):
+                    return value
+                return choices.index(value) if value in choices else 0
+            return index
         if self.type == "float32":
-            return float(value) * factor
-        v = float(value) * factor / self.scale
-        if v != v:  # NaN
-            return 0
+            return lambda value: float(value) * factor  # float(True) is float(1)
+        scale = self.scale
         lo, hi = self._saturation
-        return lo if v <= lo else hi if v >= hi else int(round(v))
+
+        def scaled(value):
+            v = float(value) * factor / scale
+            if v != v:  # NaN
+                return 0
+            return lo if v <= lo else hi if v >= hi else int(round(v))
+        return scaled
 
     @cached_property
     def _saturation(self) -> tuple[int, int]:
@@ -199,7 +220,7 @@ class Entry:
 
     def pack_into(self, buffer, offset: int, value, *, engineering: bool = False) -> None:
         """`encode`'s words written big-endian into `buffer` at byte `offset` (a register image)."""
-        self._packer.pack_into(buffer, offset, self.counts_of(value, engineering=engineering))
+        self._packer.pack_into(buffer, offset, (self.engineering_counter if engineering else self.counter)(value))
 
     def encode(self, value, *, engineering: bool = False) -> list[int]:
         """SI value -> register words (big-endian, high word first), or [0/1] for a bit. `engineering`: the

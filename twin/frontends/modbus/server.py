@@ -262,8 +262,21 @@ class ModbusServer:
     def _serve(self) -> None:
         """One turn: answer connections round-robin, within this step period's budget. Connections with a
         backlog use the budget less a reserve (a tenth) kept for connections that were idle, so a client
-        asking one request at a time is answered at once however busy the others keep the server."""
+        asking one request at a time is answered at once however busy the others keep the server. Lockstep
+        steps asked for in the turn run at its end, once the requests are answered and counted (the watchdog
+        fed), without a turn of the loop in between (`Backend.hold_steps`, `run_steps`)."""
         self._scheduled = None
+        hold = getattr(self.backend, "hold_steps", None)
+        if hold is None:
+            self._turn()
+            return
+        hold()
+        try:
+            self._turn()
+        finally:
+            self.backend.run_steps()
+
+    def _turn(self) -> None:
         clock = self.clock
         now = clock()
         if now >= self._window + self.step_period:
