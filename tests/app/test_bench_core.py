@@ -14,7 +14,7 @@ def test_bench_core_against_a_revision_measures_both_trees():
     assert run.returncode == 0, run.stderr
     lines = run.stdout.splitlines()
     assert "HEAD" in lines[1] and "this tree" in lines[1]
-    for row in ("at rest ring_rig twin/physics", "in motion x real time (wall)", "in motion, the twin adds (%)"):
+    for row in ("at rest ring_rig twin/physics", "in motion x real time (wall)", "in motion, the twin's step adds (%)"):
         line = next(line for line in lines if line.startswith(row))
         assert line.count("[") == 2, line  # one figure per tree
 

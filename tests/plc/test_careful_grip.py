@@ -93,9 +93,11 @@ def test_a_jam_on_the_bench_is_named_with_its_finger_and_the_ring_stays_put(benc
 def test_a_force_reading_stuck_at_zero_never_confirms_and_names_the_sensor(bench):
     FaultInjector.attach(bench.twin, [ReadingStuck(signal="L3.force", value=0.0)])
     bench.request("grip_request")
-    image = bench.wait(Phase.HELD, Phase.FAULT_MISSED)
+    pressed = []  # finger 2's true force at every scan (the PLC lets go within the scan that names the fault)
+    image = bench.plc.run_until(lambda image, state: pressed.append(bench.twin.finger_forces()["L3"])
+                                or state.phase in (Phase.HELD, Phase.FAULT_MISSED), timeout=10.0)
     st = bench.plc.state
     assert st.phase is Phase.FAULT_MISSED and (st.fault, st.fault_axis) == (Fault.FORCE_READING, "L3")
     # the physics: finger 2 does press on the ring (its true force), only its reading says 0 N
     assert image["L3.contact"] and image["L3.force"] == 0.0
-    assert bench.twin.finger_forces()["L3"] >= 200.0
+    assert max(pressed) >= 200.0

@@ -29,7 +29,7 @@ A station's stiffness above that limit makes its drive rigid up to its effort. A
 almost no force; a finger stopped by a part presses with K times how far its setpoint lies past it, up to the effort.
 What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
-target objects (averaged over the substeps; a revolute finger's is the torque about its joint of those contacts' force, friction included),
+target objects (as the step's last substep leaves them, as a sensor samples; a revolute finger's is the torque about its joint of those contacts' force, friction included),
 and an axis's speed comes from its positions (pybullet's joint velocity reads the motor's target where a contact
 holds the joint back). Mimic joints are tied to their master by a gear constraint (one motor moves the whole
 linkage). Stepping by hand (fixedTimeStep = step / substeps, one stepSimulation per substep) keeps both motor limits
@@ -710,8 +710,9 @@ class Gripper:
         return self._quiet
 
     def measure(self, last: bool = True) -> None:
-        """After a physics substep: add up the drives' applied forces and the fingers' contact forces. While every
-        drive stands quiet, the step's last substep alone is read (nothing moves in between)."""
+        """After a physics substep: add up the drives' applied forces; after the step's last, read the fingers'
+        contact forces. While every drive stands quiet, the step's last substep alone is read (nothing moves in
+        between)."""
         if self._quiet and not last:
             return
         self._n += 1
@@ -728,6 +729,8 @@ class Gripper:
             self._speeds = [(s[0] - b[0]) / elapsed for s, b in zip(states, before)]
         self._ticks = 0
         self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
+        if not last:  # the contacts' forces: as the step's last substep leaves them (one query a step, not one a
+            return  # substep: a held part's dozen contact points cost a quarter of the twin's own work in motion)
         sums, key_of = self._force_sum, self._link_keys.get
         if self._joint_frames:
             self._joint_frames.clear()
@@ -792,7 +795,7 @@ class Gripper:
         self._idle_statuses = None
         pressing: dict[str, dict[str, float]] = {}
         for (finger, uid), total in self._force_sum.items():
-            pressing.setdefault(finger, {})[self._target_by_id[uid]] = total / n
+            pressing.setdefault(finger, {})[self._target_by_id[uid]] = total
         fingers = {}
         for finger in self.finger_links:
             pressed = pressing.get(finger)

@@ -194,6 +194,7 @@ class Trajectory:
         self._steps = np.diff(self._knots, axis=0)
         with np.errstate(divide="ignore", invalid="ignore"):  # (an interval of no length is never looked up)
             self._slopes = self._steps / np.diff(self._s)[:, None]
+        self._lists = None  # knots, steps and slopes as lists (`state_lists`), formed when first asked for
         self.profile = profile
         self.duration = profile.duration
         self.path = path
@@ -241,6 +242,24 @@ class Trajectory:
         s, v = self.profile.s(t)
         q, dq = self._at(s)
         return q, dq * v
+
+    def state_lists(self, t: float, shift: list[float], zero: list[float]) -> tuple[list[float], list[float]]:
+        """`state` as lists, q shifted: q + shift - zero elementwise (a blend's base and start), the very floats the
+        arrays would hold, in plain Python: at every physics substep a handful of numpy operations on six values cost
+        more than the arithmetic (the arm's command at each substep)."""
+        s, v = self.profile.s(t)
+        if self._n == 0:
+            return [b + (k - z) for b, k, z in zip(shift, self._knots[0].tolist(), zero)], [0.0] * len(zero)
+        lists = self._lists
+        if lists is None:
+            lists = self._lists = (self._knots.tolist(), self._steps.tolist(), self._slopes.tolist())
+        s_list = self._s_list
+        i = min(max(bisect.bisect_right(s_list, s) - 1, 0), self._n - 1)
+        s0 = s_list[i]
+        f = (s - s0) / (s_list[i + 1] - s0)
+        knots, steps, slopes = lists
+        return ([b + ((k + f * d) - z) for b, k, d, z in zip(shift, knots[i], steps[i], zero)],
+                [k * v for k in slopes[i]])
 
     def done(self, t: float) -> bool:
         return t >= self.duration

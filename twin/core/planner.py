@@ -81,6 +81,7 @@ class Segment:
         self.ready = start  # when the program may go on past this motion (its largest zone reached)
         self.corner_failure = False  # a zone point that became a stop point: its next motion came too late
         self.radius = 0.0  # the zone's radius as reduced for its neighbours (m), once its corner is planned
+        self.lists = None  # (the queue's base it was formed for, that base and q0 as lists): `MotionQueue.command`
 
     @property
     def end(self) -> float:
@@ -178,6 +179,19 @@ class MotionQueue:
                 if t < s.end:
                     qd += qds
         return q, qd
+
+    def command(self, t: float) -> tuple[list[float], list[float]]:
+        """`state` as lists of floats, the same values (what the robot sends pybullet at every physics substep)."""
+        segments = self.segments
+        if len(segments) != 1:
+            q, qd = self.state(t)
+            return q.tolist(), qd.tolist()
+        s = segments[0]
+        lists = s.lists
+        if lists is None or lists[0] is not self.q_base:
+            lists = s.lists = (self.q_base, self.q_base.tolist(), s.q0.tolist())
+        q, qd = s.traj.state_lists(t - s.start, lists[1], lists[2])
+        return q, (qd if s.start < t < s.end else [v * 0.0 for v in qd])
 
     # -- corners ------------------------------------------------------------------------------------
     def _corner(self, prev: Segment, nxt: Trajectory, now: float) -> float | None:

@@ -322,7 +322,7 @@ class Robot:
                 self._hold, self._hold_for = queue.q(queue.end), traj
             self._command_hold(self._hold)
         elif rate == 1.0:
-            self._command(*queue.state(tau))
+            self._command(*queue.command(tau))
         else:  # StopMove / StartMove: on the path, at the clock's rate
             q, qd = queue.state(tau)
             self._command(q, qd * rate)
@@ -341,5 +341,8 @@ class Robot:
 
 
 def _floats(values) -> list[float]:
-    """Python floats for pybullet (an array's `tolist` gives the very same values, without a loop in Python)."""
+    """Python floats for pybullet (an array's `tolist` gives the very same values, without a loop in Python; a list
+    is taken as it is: the motion queue's `command` gives lists of floats at every substep)."""
+    if type(values) is list:
+        return values
     return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]

@@ -1,7 +1,7 @@
 """A cell at rest costs almost no physics: its loose bodies are frozen until something can move them.
 
-pybullet solves every resting contact at every substep: the ring rig's steel ring lying on its pallet (12 boxes,
-48 contact points) costs three quarters of the rig's physics, while nothing happens. pybullet's own sleeping cannot
+pybullet solves every resting contact at every substep: a steel ring lying flat on a pallet (12 boxes, 48 contact
+points) cost three quarters of the ring rig's physics, while nothing happens. pybullet's own sleeping cannot
 help there: a body shares its simulation island with every body whose bounding box overlaps its own (the open
 gripper's fingers around the ring), and the arm, which holds its pose under motor control, never sleeps.
 
