@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import tomllib
 import xml.etree.ElementTree as ET
 
@@ -171,6 +172,11 @@ stiffness = {effort / full_error}
         assert any(f" {jaw} force: " in ln for ln in lines(text, "FAIL")), text
         finger = next(f for f in grip(report, "block", "outside")["fingers"] if f["finger"] == jaw)
         assert finger["force"] == pytest.approx(share * effort, rel=0.2)  # what K x error gives, not the effort
+        # and it says why: the range ends the block's half width past where the finger stands on it
+        line = next(ln for ln in lines(text, "FAIL") if f" {jaw} force: " in ln)
+        said = re.search(r"its range ends only ([\d.]+) mm past", line)
+        assert said and float(said.group(1)) == pytest.approx(past * 1000, abs=0.2), line
+        assert f"[gripper.joints.{jaw}] stiffness" in line
     consistent_exit(code, text)
 
 

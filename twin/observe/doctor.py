@@ -82,6 +82,7 @@ class FingerResult:
     normal_force: float | None = None  # mean sum of the contact normal forces on the part (N)
     penetration: float | None = None  # m, >= 0: the deepest overlap of the nominal shapes while pressing (into the part)
     closest: float | None = None  # m: their smallest signed distance then (> 0: apart, < 0: overlapping by -closest)
+    short_of_goal: float | None = None  # how far its drive stood short of its command (the range's end) while pressing
 
 
 @dataclass
@@ -786,10 +787,29 @@ class Doctor:
             r.penetration = None if pen[f] is None else max(0.0, -pen[f])
             d = drive_of[f]
             r.expected_force = g.chain_effort(d) * self.linkage_share(f, d, fingers)  # the weakest in its chain
+            r.short_of_goal = abs(goal[d] - float(tw.read(f"{d}.actual")))
         result.weight = self.weight(name)
         result.capacity = mu * sum(r.normal_force for r in res.values())
         self.judge(where, want, status, res, moving, result, mu)
         self.judge_slip(name, where, "the hold")
+
+    def range_hint(self, r: FingerResult) -> str:
+        """Why a finger presses short of its effort where its drive's range ends too close past the part: a stalled
+        drive presses with its stiffness times how far its command lies past where it stands (docs/station-format.md,
+        the drive model), and the doctor commands the range's end."""
+        drive = self.g.drives[r.drive]
+        if r.short_of_goal is None or drive.rigid:
+            return ""
+        most = drive.stiffness * r.short_of_goal
+        if most >= (1 - FORCE_TOLERANCE) * self.g.chain_effort(r.drive):
+            return ""
+        unit = self.unit[r.drive]
+        spring, u = ((f"{drive.stiffness / 1000:.4g} N/mm", "N") if unit == "m"
+                     else (f"{drive.stiffness / 1000:.4g} N m/mrad", "N m"))
+        return (f": its range ends only {_fmt_len(r.short_of_goal, unit)} past where {r.drive} stands on the part, "
+                f"and its drive's spring ({spring}) presses with at most {most:.4g} {u} there; a range that reaches "
+                f"{_fmt_len(self.g.chain_effort(r.drive) / drive.stiffness, unit)} past the part (or a stiffer drive: "
+                f"[gripper.joints.{r.drive}] stiffness) gives the whole effort")
 
     def judge(self, where, want, status, res, moving, result, mu) -> None:
         for f, r in res.items():
@@ -817,7 +837,8 @@ class Doctor:
             ok = abs(ratio - 1) <= FORCE_TOLERANCE
             self.check(PASS if ok else FAIL, where, f, "force",
                        f"{r.force:.4g} {u} (from {r.force_range[0]:.4g} to {r.force_range[1]:.4g}) against "
-                       f"{r.expected_force:.4g} {u} of effort: {ratio:.3f} (within {FORCE_TOLERANCE:.0%})")
+                       f"{r.expected_force:.4g} {u} of effort: {ratio:.3f} (within {FORCE_TOLERANCE:.0%})"
+                       + ("" if ok or ratio > 1 else self.range_hint(r)))
             if r.penetration is None:
                 self.check(WARN, where, f, "penetration", "not measured (the finger's shapes)")
             else:
