@@ -139,6 +139,16 @@ class WindowImage:
             return (self.words[lay.in_offset[COIL] + k // 16] >> (k % 16)) & 1
         return self.words[lay.in_offset[HOLDING_REGISTER] + k - lay.out_offset[HOLDING_REGISTER]]
 
+    def out_words(self, lo: int, hi: int) -> list[int]:
+        """The current values of words lo..hi-1 of the output window (`out_word`'s, the holding registers in one slice)."""
+        lay = self.layout
+        first = lay.out_offset[HOLDING_REGISTER]  # the output window's first holding register
+        words = [self.out_word(k) for k in range(lo, min(hi, first))]
+        if hi > first:
+            base = lay.in_offset[HOLDING_REGISTER] - first
+            words += self.words[base + max(lo, first):base + hi]
+        return words
+
 
 _MBAP = struct.Struct(">HHHBB")  # transaction, protocol, length, unit, function
 _FC23 = struct.Struct(">HHHBBHHHHB")  # MBAP, function 23, read address and count, write address and count, bytes
@@ -511,7 +521,9 @@ class TwinClient:
         lo, hi = min(mine), max(mine)
         if hi - lo + 1 > MAX_RW_WRITE:
             return None
-        block = [mine[k] if k in mine else image.out_word(k) for k in range(lo, hi + 1)]
+        block = image.out_words(lo, hi + 1)
+        for k, w in mine.items():
+            block[k - lo] = w
         return lo, block
 
     # -- by name ------------------------------------------------------------------------------------

@@ -333,6 +333,7 @@ class _Connection(asyncio.Protocol):
         self.read_only = False  # Modbus/TCP Security: the client certificate's role grants reads only (twin.frontends.modbus.roles)
         self.buf = bytearray()
         self.transport: asyncio.Transport | None = None
+        self.loop: asyncio.AbstractEventLoop | None = None  # the server's (asking asyncio for it costs a system call)
         self.timer: asyncio.TimerHandle | None = None
         self.writing_paused = False
         self.reading_paused = False
@@ -349,7 +350,8 @@ class _Connection(asyncio.Protocol):
 
     def connection_made(self, transport) -> None:
         self.transport = transport
-        self.last_request = asyncio.get_running_loop().time()
+        self.loop = loop = asyncio.get_running_loop()
+        self.last_request = loop.time()
         sock = transport.get_extra_info("socket")
         if sock is not None:
             for level, opt, value in ((socket.IPPROTO_TCP, socket.TCP_NODELAY, 1),
@@ -427,7 +429,7 @@ class _Connection(asyncio.Protocol):
         self.reason = self.reason or reason
         self.closed = True
         self.transport.close()
-        asyncio.get_running_loop().call_later(self.server.frame_timeout, self.transport.abort)
+        self.loop.call_later(self.server.frame_timeout, self.transport.abort)
 
     def pause_writing(self) -> None:  # the client does not read its answers: stop reading its requests
         self.writing_paused = True
@@ -470,7 +472,7 @@ class _Connection(asyncio.Protocol):
             if len(self.buf) >= READ_BACKLOG:
                 self._pause_reading()
         elif self.timer is None:
-            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+            self.timer = self.loop.call_later(self.server.frame_timeout, self._stalled)
 
     def has_request(self) -> bool:
         """A complete frame (or a header that cannot be framed, to be refused) waits at the front."""
@@ -505,7 +507,7 @@ class _Connection(asyncio.Protocol):
                 break
             if n - pos < 6 + length:
                 break
-            request = bytes(buf[pos + 7:pos + 6 + length])
+            request = bytes(memoryview(buf)[pos + 7:pos + 6 + length])
             if self.clock_only and not clock(request):
                 self.clock_only = False
             response = handle(unit, request, self.hold, self.read_only)
@@ -518,7 +520,7 @@ class _Connection(asyncio.Protocol):
             out.append(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
         if pos:
             del buf[:pos]
-            self.last_request = asyncio.get_running_loop().time()
+            self.last_request = self.loop.time()
         if out:
             self.transport.write(b"".join(out))  # may call pause_writing
         if bad:
@@ -527,7 +529,7 @@ class _Connection(asyncio.Protocol):
         if len(buf) < READ_BACKLOG and not self.writing_paused:
             self._resume_reading()
         if buf and not self.has_request() and self.timer is None and not self.writing_paused:
-            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+            self.timer = self.loop.call_later(self.server.frame_timeout, self._stalled)
         return count
 
     def _finish(self, tid: int, unit: int, deferred: Deferred) -> None:
@@ -541,7 +543,7 @@ class _Connection(asyncio.Protocol):
             if not self.queued and not self.writing_paused:
                 self.server.want_turn(self, fresh=False)
         elif self.buf and self.timer is None:
-            self.timer = asyncio.get_running_loop().call_later(self.server.frame_timeout, self._stalled)
+            self.timer = self.loop.call_later(self.server.frame_timeout, self._stalled)
         if not self.writing_paused and len(self.buf) < READ_BACKLOG:
             self._resume_reading()
 
