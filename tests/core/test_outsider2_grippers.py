@@ -1,0 +1,370 @@
+"""Issue 18 from outside: six grippers of a second outsider's own making (tests/grippers/o2_*), written from the
+README and docs/ alone, checked through the documented simulation API and `twin check` against statics and
+geometry computed here from the URDFs as written (never against the twin's own numbers).
+
+Geometry, as the URDFs are written (tests/grippers/o2_*/gripper.urdf):
+- o2_quad_25n: four prismatic fingers at 0, 90, 180, 270 degrees; a finger's joint value is the radius of its
+  inner face; a 30 mm cube of 50 g. Statics: 25 N each.
+- o2_pivot_2f: two levers on pivots at x = -/+30 mm, 80 mm above a lying cylinder's axis (r = 20 mm); each
+  lever's inner face lies in the plane of its pivot axis (a line through the pivot at angle theta from the
+  vertical, closing positive). The face meets the cylinder at theta = atan(30/80) - asin(20/d), d = |pivot -
+  axis|; a contact's normal force has the arm sqrt(d^2 - r^2) along the face and its friction (along the face)
+  none, so each lever's torque about its pivot is 1.5 N m and its normal force 1.5 / sqrt(d^2 - r^2).
+- o2_chuck3_mimic(_bore): ONE 90 N input (f1); f2 a 1:1 mimic, f3 a mimic with multiplier -1 and offset 0.06
+  (its inner face at radius 0.06 - q3 = q1). Virtual work: 90 = F1 + F2 + F3, the free part takes equal forces:
+  30 N per jaw. Disc r = 30 mm (touch at q1 = 0.030); ring bore 60 mm across faces, 12 faces, one facing each
+  jaw (jaw outer face at q1 + 10 mm: touch at q1 = 0.020).
+- o2_heavy_2000n: 2000 N jaws of 5 kg, inner faces at x = +q_a and -q_b; a 120 mm wide block of 20 kg.
+- o2_feather_1n: 1 N fingers of 5 g, inner faces at +/- q, a 15 mm cube of 5 g.
+- o2_sloppy_export: 1e-9 kg m^2 on a 30 g finger with velocity 0, a finger with no inertial and no effort.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import pytest
+
+from twin.core import Twin
+
+ROOT = Path(__file__).resolve().parents[2]
+GRIPPERS = ROOT / "tests" / "grippers"
+G = 9.81
+MU = 0.8 * 0.5  # docs: fingers' friction 0.8 (default) x the part's 0.5 (default)
+
+
+def _quat_rotate(q, v):
+    x, y, z, w = q
+    # v' = v + 2 w (u x v) + 2 u x (u x v)
+    ux, uy, uz = x, y, z
+    cx, cy, cz = uy * v[2] - uz * v[1], uz * v[0] - ux * v[2], ux * v[1] - uy * v[0]
+    ccx, ccy, ccz = uy * cz - uz * cy, uz * cx - ux * cz, ux * cy - uy * cx
+    return (v[0] + 2 * (w * cx + ccx), v[1] + 2 * (w * cy + ccy), v[2] + 2 * (w * cz + ccz))
+
+
+def box_support(pose, half, u):
+    """How far the box reaches along the horizontal unit direction u from the origin (its deepest corner)."""
+    pos, quat = pose
+    best = -1e9
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            for sz in (-1, 1):
+                c = _quat_rotate(quat, (sx * half[0], sy * half[1], sz * half[2]))
+                best = max(best, (pos[0] + c[0]) * u[0] + (pos[1] + c[1]) * u[1])
+    return best
+
+
+def cylinder_support(pose, radius, height, u):
+    """How far an upright cylinder reaches along horizontal u (its axis tilt included)."""
+    pos, quat = pose
+    a = _quat_rotate(quat, (0.0, 0.0, 1.0))
+    au = a[0] * u[0] + a[1] * u[1]
+    return pos[0] * u[0] + pos[1] * u[1] + radius * math.sqrt(max(0.0, 1 - au * au)) + height / 2 * abs(au)
+
+
+def dist3(a, b):
+    return math.dist(a, b)
+
+
+@dataclass
+class Spec:
+    station: str
+    target: str
+    fingers: list[str]                    # finger signal names
+    close: dict[str, float]               # input -> setpoint (the range's end past the part)
+    force: dict[str, float]               # finger -> statics (N, or N m for a lever)
+    penetration: object                   # f(twin) -> {finger: overlap in m}, from the URDF's geometry
+    ranges: dict[str, tuple[float, float]]  # every input's URDF range
+    weight: float                         # N
+    normal: object = None                 # f(force signals) -> total normal force on the part (N)
+    status: int = 2
+    angular: tuple[str, ...] = ()
+    lift: str | None = None
+    settle: float = 0.5                   # s left alone before the resting creep is measured
+    rest: float = 5.0                     # s of resting creep, then the closing command
+
+
+def _unit(deg):
+    return (math.cos(math.radians(deg)), math.sin(math.radians(deg)))
+
+
+def quad_penetration(tw):
+    pose = tw.object_pose("cube")
+    out = {}
+    for f, deg in (("f_px", 0), ("f_py", 90), ("f_nx", 180), ("f_ny", 270)):
+        out[f] = box_support(pose, (0.015, 0.015, 0.015), _unit(deg)) - tw.read(f + ".actual")
+    return out
+
+
+def two_jaw_box_penetration(target, half, a, b):
+    def pen(tw):
+        pose = tw.object_pose(target)
+        return {a: box_support(pose, half, (1.0, 0.0)) - tw.read(a + ".actual"),
+                b: box_support(pose, half, (-1.0, 0.0)) - tw.read(b + ".actual")}
+    return pen
+
+
+def chuck_penetration(tw):
+    # mimic followers have no input: their positions are the linkage's (q2 = q1, q3 = 0.06 - (0.06 - q1) = q1)
+    q = tw.read("f1.actual")
+    pose = tw.object_pose("disc")
+    return {f: cylinder_support(pose, 0.03, 0.02, _unit(deg)) - q for f, deg in (("f1", 0), ("f2", 120), ("f3", 240))}
+
+
+def bore_penetration(tw):
+    # 12-gon bore, 30 mm to each face, a face facing each jaw; the jaw's outer face at q1 + 10 mm
+    q = tw.read("f1.actual")
+    (x, y, _), _ = tw.object_pose("ring")
+    return {f: (q + 0.010) - (0.030 + x * u[0] + y * u[1])
+            for f, u in (("f1", _unit(0)), ("f2", _unit(120)), ("f3", _unit(240)))}
+
+
+PIVOT_X, PIVOT_DZ, ROLL_R, ROLL_Z = 0.03, 0.08, 0.02, 0.12
+PIVOT_D = math.hypot(PIVOT_X, PIVOT_DZ)
+PIVOT_ARM = math.sqrt(PIVOT_D ** 2 - ROLL_R ** 2)        # 83.07 mm
+PIVOT_TOUCH = math.atan2(PIVOT_X, PIVOT_DZ) - math.asin(ROLL_R / PIVOT_D)  # 0.1225 rad
+
+
+def pivot_penetration(tw):
+    (cx, _, cz), _ = tw.object_pose("roll")
+    pz = 0.2 + tw.read("lift.actual")
+    out = {}
+    for f, px, sx in (("lever_l", -PIVOT_X, 1.0), ("lever_r", PIVOT_X, -1.0)):
+        th = tw.read(f + ".actual")
+        n = (sx * math.cos(th), math.sin(th))   # the inner face's normal, towards the part
+        out[f] = ROLL_R - ((cx - px) * n[0] + (cz - pz) * n[1])
+    return out
+
+
+SPECS = {
+    "quad": Spec("o2_quad_25n", "cube", ["f_px", "f_py", "f_nx", "f_ny"],
+                 {f: 0.0 for f in ("f_px", "f_py", "f_nx", "f_ny")}, {f: 25.0 for f in ("f_px", "f_py", "f_nx", "f_ny")},
+                 quad_penetration, {"lift": (0, 0.1), **{f: (0, 0.04) for f in ("f_px", "f_py", "f_nx", "f_ny")}},
+                 weight=0.03 ** 3 * 1852.0 * G, normal=lambda F: sum(F.values()), lift="lift"),
+    "pivot": Spec("o2_pivot_2f", "roll", ["lever_l", "lever_r"], {"lever_l": 0.5, "lever_r": 0.5},
+                  {"lever_l": 1.5, "lever_r": 1.5}, pivot_penetration,
+                  {"lift": (0, 0.1), "lever_l": (-0.3, 0.5), "lever_r": (-0.3, 0.5)},
+                  weight=math.pi * 0.02 ** 2 * 0.08 * 994.7184 * G, normal=lambda F: sum(F.values()) / PIVOT_ARM,
+                  angular=("lever_l", "lever_r"), lift="lift"),
+    "chuck": Spec("o2_chuck3_mimic", "disc", ["f1", "f2", "f3"], {"f1": 0.0}, {f: 30.0 for f in ("f1", "f2", "f3")},
+                  chuck_penetration, {"f1": (0, 0.05)}, weight=math.pi * 0.03 ** 2 * 0.02 * 2700 * G,
+                  normal=lambda F: sum(F.values())),
+    "bore": Spec("o2_chuck3_mimic_bore", "ring", ["f1", "f2", "f3"], {"f1": 0.05}, {f: 30.0 for f in ("f1", "f2", "f3")},
+                 bore_penetration, {"f1": (0, 0.05)}, weight=0.0, status=1, normal=lambda F: sum(F.values())),
+    "heavy": Spec("o2_heavy_2000n", "block", ["jaw_a", "jaw_b"], {"jaw_a": 0.0, "jaw_b": 0.0},
+                  {"jaw_a": 2000.0, "jaw_b": 2000.0}, two_jaw_box_penetration("block", (0.06, 0.07, 0.075), "jaw_a", "jaw_b"),
+                  {"lift": (0, 0.1), "jaw_a": (0, 0.15), "jaw_b": (0, 0.15)}, weight=20.0 * G,
+                  normal=lambda F: sum(F.values()), lift="lift"),
+    "feather": Spec("o2_feather_1n", "cube", ["tip_a", "tip_b"], {"tip_a": 0.0, "tip_b": 0.0}, {"tip_a": 1.0, "tip_b": 1.0},
+                    two_jaw_box_penetration("cube", (0.0075,) * 3, "tip_a", "tip_b"),
+                    {"lift": (0, 0.1), "tip_a": (0, 0.02), "tip_b": (0, 0.02)}, weight=0.015 ** 3 * 1481.4815 * G,
+                    normal=lambda F: sum(F.values()), lift="lift"),
+}
+
+
+@dataclass
+class Run:
+    onset: dict = field(default_factory=dict)         # finger -> step (after the closing command) its contact rose
+    status: dict = field(default_factory=dict)        # finger -> statuses from the onset to the end
+    moving: dict = field(default_factory=dict)        # input -> steps of the hold with `moving`
+    spread: dict = field(default_factory=dict)        # input -> actual's spread over the hold (m or rad)
+    force: dict = field(default_factory=dict)         # finger -> (min, mean, max) over the hold
+    penetration: dict = field(default_factory=dict)   # finger -> deepest overlap over the hold (m)
+    push: float = 0.0                                  # part moved while closing (to all touching + 10 steps), m
+    rest_creep: float = 0.0                            # part moved resting 5 s (after 0.5 s), m
+    held_creep: float = 0.0                            # part moved in the 5 s hold (the gripper stands), m
+    slip_steps: int = 0                                # steps of the hold with `slip`
+    gripped_steps: int = 0
+    hold_steps: int = 0
+    out_of_range: list = field(default_factory=list)   # (input, actual) outside the URDF's range
+    lift_rel: float | None = None                      # part's rise minus the lift's, m (after 1 s hanging)
+    lift_slip: bool | None = None
+
+
+def _check_ranges(tw, spec, run):
+    for name, (lo, hi) in spec.ranges.items():
+        v = tw.read(name + ".actual")
+        if not (lo <= v <= hi):
+            run.out_of_range.append((name, v))
+
+
+def grip(spec: Spec, hold_s=5.0, lift=True, station=None) -> Run:
+    run = Run()
+    with Twin.from_station(station or GRIPPERS / spec.station) as tw:
+        steps = lambda s: int(round(s / 0.012))  # noqa: E731 (the default 12 ms step)
+        tw.step(steps(spec.settle))
+        p_rest = tw.object_pose(spec.target)[0]
+        for _ in range(steps(spec.rest)):
+            tw.step()
+            _check_ranges(tw, spec, run)
+        run.rest_creep = dist3(tw.object_pose(spec.target)[0], p_rest)
+        p0 = tw.object_pose(spec.target)[0]
+        for name, value in spec.close.items():
+            tw.write(name, value)
+        k = 0
+        while len(run.onset) < len(spec.fingers) and k < 400:
+            tw.step()
+            k += 1
+            _check_ranges(tw, spec, run)
+            for f in spec.fingers:
+                if f not in run.onset and tw.read(f + ".contact"):
+                    run.onset[f] = k
+            for f in run.onset:
+                run.status.setdefault(f, []).append(tw.read(f + ".status"))
+        assert len(run.onset) == len(spec.fingers), f"never touched: {set(spec.fingers) - set(run.onset)}"
+        for _ in range(10):
+            tw.step()
+            _check_ranges(tw, spec, run)
+            for f in spec.fingers:
+                run.status[f].append(tw.read(f + ".status"))
+        run.push = dist3(tw.object_pose(spec.target)[0], p0)
+        p_hold = tw.object_pose(spec.target)[0]
+        inputs = list(spec.close)
+        pos = {i: [] for i in inputs}
+        forces = {f: [] for f in spec.fingers}
+        pen = {f: -1.0 for f in spec.fingers}
+        run.moving = {i: 0 for i in inputs}
+        run.hold_steps = steps(hold_s)
+        for _ in range(run.hold_steps):
+            tw.step()
+            _check_ranges(tw, spec, run)
+            for f in spec.fingers:
+                run.status[f].append(tw.read(f + ".status"))
+                forces[f].append(tw.read(f + ".force"))
+            for i in inputs:
+                pos[i].append(tw.read(i + ".actual"))
+                run.moving[i] += bool(tw.read(i + ".moving"))
+            for f, d in spec.penetration(tw).items():
+                pen[f] = max(pen[f], d)
+            run.slip_steps += bool(tw.read("slip"))
+            run.gripped_steps += bool(tw.read("doGripped"))
+        run.held_creep = dist3(tw.object_pose(spec.target)[0], p_hold)
+        run.spread = {i: max(v) - min(v) for i, v in pos.items()}
+        run.force = {f: (min(v), sum(v) / len(v), max(v)) for f, v in forces.items()}
+        run.penetration = pen
+        if lift and spec.lift:
+            z0, l0 = tw.object_pose(spec.target)[0][2], tw.read(spec.lift + ".actual")
+            tw.write(spec.lift, 0.03)
+            tw.step(steps(0.03 / 0.05 + 1.0))
+            for _ in range(5):
+                tw.step()
+                _check_ranges(tw, spec, run)
+            run.lift_rel = (tw.object_pose(spec.target)[0][2] - z0) - (tw.read(spec.lift + ".actual") - l0)
+            run.lift_slip = bool(tw.read("slip"))
+    return run
+
+
+_RUNS: dict[str, Run] = {}
+
+
+def measured(key) -> Run:
+    if key not in _RUNS:
+        _RUNS[key] = grip(SPECS[key])
+    return _RUNS[key]
+
+
+# the lying cylinder rolls off at rest (test_resting_part...[pivot]): its grip is also measured closing at once
+SPECS["pivot_now"] = replace(SPECS["pivot"], settle=0.0, rest=0.0)
+ALL = list(SPECS)
+
+
+def _status_settles(run: Run, spec: Spec):
+    """Per finger: steps from its touch to the first status that then holds to the end, or None."""
+    out = {}
+    for f, seq in run.status.items():
+        last_bad = max((i for i, s in enumerate(seq) if s != spec.status), default=-1)
+        out[f] = last_bad + 1 if last_bad + 1 < len(seq) else None
+    return out
+
+
+KNOWN = {
+    # (measure, gripper) -> what fails, as measured on main at 5b5d818
+    ("force", "chuck"): "one-input 3-jaw chuck (mimics 1:1 and -1+0.06; the same with three 1:1 jaws): the jaws press "
+                        "40.6 / 28.3 / 20.7 N on the disc where virtual work gives 90 / 3 = 30 N each (sum 89.6 N)",
+    ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
+    ("creep", "pivot"): "a 100 g cylinder lying on a static box table rolls off at rest (6 mm/s^2 from the first step), "
+                        "rebounding between the open levers: 9.4 mm in 5 s after 0.5 s (limit 0.1 mm)",
+    ("status", "pivot"): "the levers closing on the rolling cylinder: status 0/2 alternating for 73-78 steps after "
+                         "touching (limit 10)",
+    ("still", "pivot"): "the levers closing on the rolling cylinder: `moving` in 38-41 of the 417 hold steps, "
+                        "spread 0.29-0.34 mrad",
+    ("status", "pivot_now"): "closed at once (the cylinder still): status 2 -> 0 -> 2 flicker, the last 0 13 steps "
+                             "after touching (settles at 20-21 steps; limit 10)",
+    ("still", "pivot_now"): "closed at once: `moving` in 3-4 steps of the hold, spread 0.125 mrad",
+}
+
+
+def xfail_if(measure, key):
+    reason = KNOWN.get((measure, key))
+    return pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=reason)) if reason else key
+
+
+def params(measure):
+    return [xfail_if(measure, k) for k in ALL]
+
+
+@pytest.mark.parametrize("key", params("status"))
+def test_status_settles_within_10_steps_and_stays(key):
+    spec, run = SPECS[key], measured(key)
+    settle = _status_settles(run, spec)
+    assert all(s is not None and s <= 10 for s in settle.values()), (settle, {f: s[:14] for f, s in run.status.items()})
+
+
+@pytest.mark.parametrize("key", params("still"))
+def test_stalled_fingers_stand_still(key):
+    spec, run = SPECS[key], measured(key)
+    limit = {i: (0.001 if i in spec.angular else 0.00005) for i in run.spread}
+    assert all(run.moving[i] == 0 for i in run.moving), run.moving
+    assert all(run.spread[i] <= limit[i] for i in run.spread), run.spread
+
+
+@pytest.mark.parametrize("key", params("force"))
+def test_force_is_the_drives_effort_by_statics(key):
+    spec, run = SPECS[key], measured(key)
+    bad = {f: run.force[f] for f in spec.fingers if abs(run.force[f][1] - spec.force[f]) > 0.1 * spec.force[f]}
+    assert not bad, f"statics {spec.force}, measured (min, mean, max) {bad}"
+
+
+@pytest.mark.parametrize("key", params("penetration"))
+def test_penetration_at_most_half_a_millimetre(key):
+    run = measured(key)
+    assert max(run.penetration.values()) <= 0.0005, run.penetration
+    # and they do touch: a finger pressing with its effort is not standing off the part
+    assert min(run.penetration.values()) >= -0.0002, run.penetration
+
+
+@pytest.mark.parametrize("key", params("push"))
+def test_centred_closing_grip_does_not_push_the_part(key):
+    run = measured(key)
+    assert run.push < 0.0005, run.push
+
+
+@pytest.mark.parametrize("key", params("creep"))
+def test_resting_part_creeps_less_than_0_1_mm_and_held_less_than_0_2_mm(key):
+    run = measured(key)
+    assert run.rest_creep < 0.0001 and run.held_creep < 0.0002, (run.rest_creep, run.held_creep)
+
+
+@pytest.mark.parametrize("key", params("slip"))
+def test_slip_never_rises_on_a_part_held_still_and_the_grip_is_reported(key):
+    run = measured(key)
+    assert run.slip_steps == 0 and run.gripped_steps == run.hold_steps, (run.slip_steps, run.gripped_steps)
+
+
+@pytest.mark.parametrize("key", params("range"))
+def test_actuals_never_leave_their_range(key):
+    assert not measured(key).out_of_range
+
+
+@pytest.mark.parametrize("key", [xfail_if("lift", k) for k in ALL if SPECS[k].lift])
+def test_grip_with_3x_capacity_lifts_the_part_within_1_mm(key):
+    spec, run = SPECS[key], measured(key)
+    capacity = MU * spec.normal({f: run.force[f][1] for f in spec.fingers})
+    assert capacity >= 3 * spec.weight   # statics from the measured forces: this grip must hold
+    assert abs(run.lift_rel) < 0.001 and not run.lift_slip, (run.lift_rel, run.lift_slip)
