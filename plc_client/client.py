@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from twin.frontends.modbus.pdu import IMAGE_IN, IMAGE_OUT, ImageLayout
 from twin.frontends.modbus.protocol import (DEFAULT_PORT, MAX_READ_BITS, MAX_READ_REGISTERS, MAX_RW_WRITE, MAX_WRITE_BITS,
                                   MAX_WRITE_REGISTERS, TLS_PORT)
 from twin.frontends.modbus.register_map import (ADVANCE, BIT_TABLES, COIL, DISCRETE_INPUT, DT_US, HOLDING_REGISTER,
@@ -403,8 +404,6 @@ class TwinClient:
     def layout(self):
         """Where each table sits in the server's process-image windows (computed from the map, as the server does)."""
         if getattr(self, "_layout", None) is None:
-            from twin.frontends.modbus.pdu import ImageLayout
-
             self._layout = ImageLayout({t: self.map.size(t) for t in TABLES})
         return self._layout
 
@@ -415,8 +414,6 @@ class TwinClient:
 
     def read_window(self) -> "WindowImage":
         """The whole input window in one request (function 3)."""
-        from twin.frontends.modbus.pdu import IMAGE_IN
-
         n = self.layout.in_size
         r = self._call(3, "read_holding_registers", IMAGE_IN, n, (), count=n)
         return WindowImage(self, list(r.registers))
@@ -428,8 +425,6 @@ class TwinClient:
         server answers once the steps are done, so the image returned is the state after them. `image`
         (the last one read) gives the current values of the words between the ones written. `checked`: the
         values have passed `check_value` already (a scan's outputs, checked when the scan set them)."""
-        from twin.frontends.modbus.pdu import IMAGE_IN, IMAGE_OUT
-
         words = self._out_words(values, image, advance, checked)
         if words is None:
             raise PlcClientError("the output window cannot be filled from the last image")
@@ -499,8 +494,6 @@ class TwinClient:
 
     def write_window(self, values: Mapping[str, Any], image: "WindowImage") -> None:
         """Write `values` into the output window in one request (function 16)."""
-        from twin.frontends.modbus.pdu import IMAGE_OUT
-
         start, block = self._out_words(values, image, 0)
         self._call(16, "write_registers", IMAGE_OUT + start, len(block), check_names(self.map, values), block)
 

@@ -93,6 +93,29 @@ def test_the_lockstep_runner_runs_exactly_the_steps_requested():
     assert asyncio.run(run()) == 10
 
 
+def test_steps_asked_while_the_lockstep_runner_is_held_run_at_its_release_not_before():
+    """A server holds the runner while it answers a turn's requests (the watchdog sees them first); the steps
+    they asked for run when it lets go, in that same turn, and the answers waiting for them go out then."""
+    async def run():
+        count, done = [], []
+        runner = LockstepRunner(lambda: count.append(1) or True)
+        task = asyncio.ensure_future(runner.run())
+        await asyncio.sleep(0.01)
+        runner.hold()
+        runner.request(3)
+        runner.when_done(lambda: done.append(len(count)))
+        await asyncio.sleep(0.02)  # turns of the loop: nothing runs while held
+        held = len(count)
+        runner.release()  # runs them now, without a turn of the loop
+        released = len(count), list(done)
+        runner.release()  # nothing held, nothing asked: nothing runs
+        runner.stop()
+        await task
+        return held, released, len(count)
+
+    assert asyncio.run(run()) == (0, (3, [3]), 3)
+
+
 async def _rpc(reader, writer, pdu: bytes) -> bytes:
     writer.write(struct.pack(">HHHB", 1, 0, len(pdu) + 1, 1) + pdu)
     head = await reader.readexactly(7)

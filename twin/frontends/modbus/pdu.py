@@ -462,6 +462,8 @@ class PduHandler:
                 if chunk[0] not in (0, 1):
                     return ILLEGAL_DATA_VALUE
                 same = images.coils[a] == chunk[0]
+            elif e.signal is None and e.writable:  # a command (below): taken whatever it reads now
+                same = False
             else:
                 if current_h is None:
                     current_h = self._holding_words(images.holding)

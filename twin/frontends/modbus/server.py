@@ -134,6 +134,8 @@ class ModbusServer:
                  log: Callable[[str], None] = _log, clock: Callable[[], float] = time.perf_counter,
                  poll_hold: float = POLL_HOLD):
         self.map, self.backend, self.unit_id = rmap, backend, unit_id
+        self._hold_steps = getattr(backend, "hold_steps", None)  # optional (`Backend`)
+        self._run_steps = getattr(backend, "run_steps", None)
         self.units = {unit_id, 0, 255}
         self.pdus = PduHandler(rmap, backend, read_only=read_only, gaps_zero=gaps_zero, identity=identity)
         self.route: Callable[[int], PduHandler | None] | None = None  # other unit ids: another device (a profile)
@@ -266,7 +268,7 @@ class ModbusServer:
         steps asked for in the turn run at its end, once the requests are answered and counted (the watchdog
         fed), without a turn of the loop in between (`Backend.hold_steps`, `run_steps`)."""
         self._scheduled = None
-        hold = getattr(self.backend, "hold_steps", None)
+        hold = self._hold_steps
         if hold is None:
             self._turn()
             return
@@ -274,7 +276,7 @@ class ModbusServer:
         try:
             self._turn()
         finally:
-            self.backend.run_steps()
+            self._run_steps()
 
     def _turn(self) -> None:
         clock = self.clock
