@@ -86,6 +86,7 @@ class Spec:
     status: int = 2
     angular: tuple[str, ...] = ()
     lift: str | None = None
+    centred: bool = True                  # the fingers close on the part from equal gaps at one speed
     settle: float = 0.5                   # s left alone before the resting creep is measured
     rest: float = 5.0                     # s of resting creep, then the closing command
 
@@ -165,6 +166,11 @@ SPECS = {
                     two_jaw_box_penetration("cube", (0.0075,) * 3, "tip_a", "tip_b"),
                     {"lift": (0, 0.1), "tip_a": (0, 0.02), "tip_b": (0, 0.02)}, weight=0.015 ** 3 * 1481.4815 * G,
                     normal=lambda F: sum(F.values()), lift="lift"),
+    "sloppy": Spec("o2_sloppy_export", "cube", ["finger_a", "finger_b"], {"finger_a": 0.0, "finger_b": 0.0},
+                   {"finger_a": 100.0, "finger_b": 100.0},  # docs: no effort given: 100 N
+                   two_jaw_box_penetration("cube", (0.015,) * 3, "finger_a", "finger_b"),
+                   {"finger_a": (0, 0.04), "finger_b": (0, 0.04)}, weight=0.03 ** 3 * 7407.4 * G,
+                   normal=lambda F: sum(F.values()), centred=False),  # 0.1 m/s (velocity 0) against 0.05 m/s
 }
 
 
@@ -339,7 +345,7 @@ def test_penetration_at_most_half_a_millimetre(key):
     assert min(run.penetration.values()) >= -0.0002, run.penetration
 
 
-@pytest.mark.parametrize("key", params("push"))
+@pytest.mark.parametrize("key", [xfail_if("push", k) for k in ALL if SPECS[k].centred])
 def test_centred_closing_grip_does_not_push_the_part(key):
     run = measured(key)
     assert run.push < 0.0005, run.push
@@ -368,3 +374,101 @@ def test_grip_with_3x_capacity_lifts_the_part_within_1_mm(key):
     capacity = MU * spec.normal({f: run.force[f][1] for f in spec.fingers})
     assert capacity >= 3 * spec.weight   # statics from the measured forces: this grip must hold
     assert abs(run.lift_rel) < 0.001 and not run.lift_slip, (run.lift_rel, run.lift_slip)
+
+
+# ---- a grip under 0.7x its part's weight drops it, with `slip` ----------------------------------------------------
+
+def weak_station(tmp_path, name, efforts):
+    """A copy of one of the o2 stations with its drives' efforts overridden in station.toml ([gripper.joints.X])."""
+    src = GRIPPERS / name
+    dst = tmp_path / name
+    shutil.copytree(src, dst)
+    text = (dst / "station.toml").read_text()
+    head, rest = text.split("[[targets]]", 1)
+    joints = "".join(f"[gripper.joints.{k}]\neffort = {v}\n\n" for k, v in efforts.items())
+    (dst / "station.toml").write_text(head + joints + "[[targets]]" + rest)
+    return dst
+
+
+def test_quad_under_0_7x_its_weight_drops_the_cube_with_slip(tmp_path):
+    # 4 x 0.2 N x mu 0.4 = 0.32 N of friction for a 0.49 N cube: 0.65x
+    spec = SPECS["quad"]
+    station = weak_station(tmp_path, spec.station, {f: 0.2 for f in spec.fingers})
+    run = grip(spec, hold_s=1.0, station=station)
+    assert all(abs(run.force[f][1] - 0.2) <= 0.02 for f in spec.fingers), run.force  # each presses its 0.2 N
+    assert MU * sum(run.force[f][1] for f in spec.fingers) < 0.7 * spec.weight
+    assert run.slip_steps == 0 and run.gripped_steps == run.hold_steps   # held still on the floor: gripped, no slip
+    assert run.lift_rel < -0.025 and run.lift_slip, (run.lift_rel, run.lift_slip)  # left behind (30 mm): slip
+
+
+# ---- twin check: its verdicts against what was measured above -----------------------------------------------------
+
+def twin_check(station, tmp_path, hold="1"):
+    out = tmp_path / "check.json"
+    proc = subprocess.run([sys.executable, "-m", "twin_app.cli", "check", str(station), "--hold", hold, "--json", str(out)],
+                          capture_output=True, text=True, timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    report = json.loads(out.read_text()) if out.exists() else None
+    return proc, report
+
+
+def _fails(report):
+    return {(c["who"], c["measure"]) for c in report["checks"] if c["level"] == "FAIL"}
+
+
+@pytest.mark.parametrize("key", ["quad", "heavy", "feather", "sloppy"])
+def test_twin_check_passes_the_grippers_whose_measures_pass(key, tmp_path):
+    proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
+    assert proc.returncode == 0 and report["verdict"] == "PASS", proc.stdout[-3000:]
+    if SPECS[key].lift:
+        assert any(c["measure"] == "lift" and c["level"] == "PASS" for c in report["checks"]), proc.stdout[-2000:]
+
+
+@pytest.mark.parametrize("key", ["chuck", "bore"])
+def test_twin_check_fails_the_chucks_jaw_forces_as_statics_does(key, tmp_path):
+    proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
+    assert proc.returncode == 1 and report["verdict"] == "FAIL"
+    # the jaws measured above off 30 N by more than 10 % are the ones it fails, on force, and nothing else
+    run = measured(key)
+    off = {f for f in SPECS[key].fingers if abs(run.force[f][1] - 30.0) > 3.0}
+    assert _fails(report) == {(f, "force") for f in off}, proc.stdout[-3000:]
+
+
+def test_twin_check_fails_the_rolling_cylinder_at_rest(tmp_path):
+    proc, report = twin_check(GRIPPERS / SPECS["pivot"].station, tmp_path)
+    assert proc.returncode == 1 and ("part", "creep") in _fails(report), proc.stdout[-3000:]
+
+
+def test_twin_check_catches_a_grip_under_its_parts_weight(tmp_path):
+    spec = SPECS["quad"]
+    proc, report = twin_check(weak_station(tmp_path, spec.station, {f: 0.2 for f in spec.fingers}), tmp_path)
+    assert proc.returncode == 1 and ("grip", "capacity") in _fails(report), proc.stdout[-3000:]
+
+
+# ---- URDF data a newcomer exports ---------------------------------------------------------------------------------
+
+def twin_info(station):
+    return subprocess.run([sys.executable, "-m", "twin_app.cli", "info", str(station)], capture_output=True, text=True,
+                          timeout=60, env={**os.environ, "PYTHONPATH": str(ROOT)})
+
+
+def test_sloppy_tiny_inertia_is_replaced_with_one_warning_naming_the_link():
+    proc = twin_info(GRIPPERS / "o2_sloppy_export")
+    assert proc.returncode == 0
+    lines = [ln for ln in (proc.stdout + proc.stderr).splitlines()
+             if "warning" in ln and "finger_a" in ln and "inertia" in ln]
+    assert len(lines) == 1 and "gripper.urdf" in lines[0], proc.stdout + proc.stderr
+
+
+def test_sloppy_finger_without_an_inertial_block_is_warned_about(tmp_path):
+    # pybullet gives a link without <inertial> 1 kg: on a 6 x 20 x 20 mm pad that is 53x steel's density
+    proc, report = twin_check(GRIPPERS / "o2_sloppy_export", tmp_path)
+    assert any(c["level"] == "WARN" and c["who"] == "finger_b" and c["measure"] == "mass" for c in report["checks"])
+
+
+@pytest.mark.xfail(strict=True, reason="a URDF velocity limit of 0 (slide_a) is silently replaced by the 0.1 m/s "
+                   "default (twin info: finger_a 0.1 m/s), no warning and no error naming the joint")
+def test_sloppy_velocity_limit_of_zero_is_warned_about_or_refused():
+    proc = twin_info(GRIPPERS / "o2_sloppy_export")
+    said = [ln for ln in (proc.stderr + proc.stdout).splitlines()
+            if ("slide_a" in ln or "finger_a" in ln) and "velocity" in ln.lower() and ("warning" in ln or "error" in ln)]
+    assert proc.returncode != 0 or said, proc.stderr
