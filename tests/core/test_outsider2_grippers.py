@@ -16,6 +16,8 @@ Geometry, as the URDFs are written (tests/grippers/o2_*/gripper.urdf):
   (its inner face at radius 0.06 - q3 = q1). Virtual work: 90 = F1 + F2 + F3, the free part takes equal forces:
   30 N per jaw. Disc r = 30 mm (touch at q1 = 0.030); ring bore 60 mm across faces, 12 faces, one facing each
   jaw (jaw outer face at q1 + 10 mm: touch at q1 = 0.020).
+- o2_pair_mimic_neg: ONE 60 N input (jaw_a, inner face at x = +q_a); jaw_b's joint 80 mm out on -x, axis +x, a
+  mimic with multiplier -1 and offset 0.08 (inner face at -q_a): 30 N per jaw; a 40 mm cube of 100 g.
 - o2_heavy_2000n: 2000 N jaws of 5 kg, inner faces at x = +q_a and -q_b; a 120 mm wide block of 20 kg.
 - o2_feather_1n: 1 N fingers of 5 g, inner faces at +/- q, a 15 mm cube of 5 g.
 - o2_sloppy_export: 1e-9 kg m^2 on a 30 g finger with velocity 0, a finger with no inertial and no effort.
@@ -216,6 +218,11 @@ SPECS = {
                   normal=lambda F: sum(F.values())),
     "bore": Spec("o2_chuck3_mimic_bore", "ring", ["f1", "f2", "f3"], {"f1": 0.05}, {f: 30.0 for f in ("f1", "f2", "f3")},
                  bore_penetration, {"f1": (0, 0.05)}, weight=0.0, status=1, normal=lambda F: sum(F.values())),
+    "pair_neg": Spec("o2_pair_mimic_neg", "cube", ["jaw_a", "jaw_b"], {"jaw_a": 0.0}, {"jaw_a": 30.0, "jaw_b": 30.0},
+                     lambda tw: {"jaw_a": box_support(tw.object_pose("cube"), (0.02,) * 3, (1.0, 0.0)) - tw.read("jaw_a.actual"),
+                                 # the follower's face at -0.08 + q_b = -q_a: the linkage's, as it has no input
+                                 "jaw_b": box_support(tw.object_pose("cube"), (0.02,) * 3, (-1.0, 0.0)) - tw.read("jaw_a.actual")},
+                     {"jaw_a": (0, 0.06)}, weight=0.04 ** 3 * 1562.5 * G, normal=lambda F: sum(F.values())),
     "heavy": Spec("o2_heavy_2000n", "block", ["jaw_a", "jaw_b"], {"jaw_a": 0.0, "jaw_b": 0.0},
                   {"jaw_a": 2000.0, "jaw_b": 2000.0}, two_jaw_box_penetration("block", (0.06, 0.07, 0.075), "jaw_a", "jaw_b"),
                   {"lift": (0, 0.1), "jaw_a": (0, 0.15), "jaw_b": (0, 0.15)}, weight=20.0 * G,
@@ -507,7 +514,7 @@ def _fails(report):
     return {(c["who"], c["measure"]) for c in report["checks"] if c["level"] == "FAIL"}
 
 
-@pytest.mark.parametrize("key", ["quad", "pivot_box", "heavy", "feather", "sloppy"])
+@pytest.mark.parametrize("key", ["quad", "pivot_box", "pair_neg", "heavy", "feather", "sloppy"])
 def test_twin_check_passes_the_grippers_whose_measures_pass(key, tmp_path):
     proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
     assert proc.returncode == 0 and report["verdict"] == "PASS", proc.stdout[-3000:]
