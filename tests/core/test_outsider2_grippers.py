@@ -99,11 +99,35 @@ def _unit(deg):
     return (math.cos(math.radians(deg)), math.sin(math.radians(deg)))
 
 
+def _rect_overlap(a, b):
+    """Separating-axis depth of two convex outlines: > 0 overlapping by that much, < 0 apart (along some axis)."""
+    depth = 1e9
+    for poly in (a, b):
+        for i in range(len(poly)):
+            (x0, z0), (x1, z1) = poly[i], poly[(i + 1) % len(poly)]
+            ln = math.hypot(x1 - x0, z1 - z0)
+            ax = (-(z1 - z0) / ln, (x1 - x0) / ln)
+            pa = [x * ax[0] + z * ax[1] for x, z in a]
+            pb = [x * ax[0] + z * ax[1] for x, z in b]
+            depth = min(depth, min(max(pa) - min(pb), max(pb) - min(pa)))
+    return depth
+
+
 def quad_penetration(tw):
-    pose = tw.object_pose("cube")
+    """Each pad (radius q..q+10 mm, 20 mm wide) against the cube's square outline in the x-y plane (its yaw)."""
+    pos, quat = tw.object_pose("cube")
+    square = []
+    for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+        c = _quat_rotate(quat, (sx * 0.015, sy * 0.015, 0.0))
+        square.append((pos[0] + c[0], pos[1] + c[1]))
     out = {}
     for f, deg in (("f_px", 0), ("f_py", 90), ("f_nx", 180), ("f_ny", 270)):
-        out[f] = box_support(pose, (0.015, 0.015, 0.015), _unit(deg)) - tw.read(f + ".actual")
+        q = tw.read(f + ".actual")
+        u = _unit(deg)
+        v = (-u[1], u[0])
+        pad = [(r * u[0] + t * v[0], r * u[1] + t * v[1]) for r, t in
+               ((q, -0.01), (q + 0.01, -0.01), (q + 0.01, 0.01), (q, 0.01))]
+        out[f] = _rect_overlap(pad, square)
     return out
 
 
@@ -150,20 +174,6 @@ def lever_rects(tw):
         out[f] = [(px + a * n[0] + b * d[0], pz + a * n[1] + b * d[1]) for a, b in
                   ((0, 0), (0, LEVER_LEN), (-LEVER_T, LEVER_LEN), (-LEVER_T, 0))]
     return out
-
-
-def _rect_overlap(a, b):
-    """Separating-axis depth of two convex outlines: > 0 overlapping by that much, < 0 apart (along some axis)."""
-    depth = 1e9
-    for poly in (a, b):
-        for i in range(len(poly)):
-            (x0, z0), (x1, z1) = poly[i], poly[(i + 1) % len(poly)]
-            ln = math.hypot(x1 - x0, z1 - z0)
-            ax = (-(z1 - z0) / ln, (x1 - x0) / ln)
-            pa = [x * ax[0] + z * ax[1] for x, z in a]
-            pb = [x * ax[0] + z * ax[1] for x, z in b]
-            depth = min(depth, min(max(pa) - min(pb), max(pb) - min(pa)))
-    return depth
 
 
 def _point_rect_distance(c, rect):
@@ -358,6 +368,8 @@ def measured(key) -> Run:
 
 # the lying cylinder rolls off at rest (test_resting_part...[pivot]): its grip is also measured closing at once
 SPECS["pivot_now"] = replace(SPECS["pivot"], settle=0.0, rest=0.0)
+# the quad on its cube placed 2 mm and -1.5 mm off centre (x, y): the first fingers push it over to the others
+SPECS["quad_off"] = replace(SPECS["quad"], station="o2_quad_25n_off", centred=False)
 ALL = list(SPECS)
 
 
@@ -377,6 +389,8 @@ KNOWN = {
     ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
     ("contact", "bore"): "opening into the bore, the step before the jaws' contact flags rose they stood 0.08 mm into the "
                          "bore's wall (all three; 0.06 mm when it rose): the flag is a step late",
+    ("contact", "quad_off"): "the cube 2 mm / -1.5 mm off centre, pushed over by f_px and f_ny: the step before f_py's "
+                             "contact flag rose its pad overlapped the cube's outline by 0.15 mm (f_nx 0.04 mm)",
     ("creep", "pivot"): "a 100 g cylinder lying on a static box table rolls off at rest (6 mm/s^2 from the first step), "
                         "rebounding between the open levers: 9.4 mm in 5 s after 0.5 s (limit 0.1 mm)",
     ("status", "pivot"): "the levers closing on the rolling cylinder: status 0/2 alternating for 73-78 steps after "
