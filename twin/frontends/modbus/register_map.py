@@ -52,7 +52,7 @@ import math
 import struct
 import zlib
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
@@ -133,6 +133,10 @@ class Entry:
     @property
     def writable(self) -> bool:
         return self.access == "rw"
+
+    def __getstate__(self) -> dict:
+        """Its fields only: the encoders cached on it (`counter`, `_packer`) are formed again where it is used."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     @property
     def end(self) -> int:
