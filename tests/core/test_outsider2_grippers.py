@@ -529,6 +529,10 @@ def weak_station(tmp_path, name, efforts):
     src = GRIPPERS / name
     dst = tmp_path / name
     shutil.copytree(src, dst)
+    for urdf in ("../o2_quad_25n/gripper.urdf",):   # the arm station names its neighbour's URDF
+        (dst / "station.toml").write_text((dst / "station.toml").read_text().replace(urdf, str(src / urdf)))
+    (dst / "station.toml").write_text((dst / "station.toml").read_text().replace(
+        "../../../stations/robots/arm6700.urdf", str(ROOT / "stations/robots/arm6700.urdf")))
     text = (dst / "station.toml").read_text()
     head, rest = text.split("[[targets]]", 1)
     joints = "".join(f"[gripper.joints.{k}]\neffort = {v}\n\n" for k, v in efforts.items())
@@ -661,3 +665,48 @@ def test_modbus_reads_what_the_simulation_api_reads(key, writes, steps):
         assert wire[n] == pytest.approx(expect, abs=0.0051), (n, wire[n], api[n])
     for i, (lo, hi) in spec.ranges.items():
         assert lo * 1000 <= wire[i + ".actual"] <= hi * 1000 and lo <= api[i + ".actual"] <= hi
+
+
+# ---- on the shipped arm: the robot lifts ---------------------------------------------------------------------------
+
+ARM = GRIPPERS / "o2_quad_25n_arm"
+QUAD = ("f_px", "f_py", "f_nx", "f_ny")
+
+
+def arm_grip_and_lift(station):
+    with Twin.from_station(station) as tw:
+        tw.step(20)
+        tw.run_motion("MoveL", "grip", 0.1)        # the open fingers down around the cube (TCP at its centre)
+        for f in QUAD:
+            tw.write(f, 0.0)
+        tw.step(80)
+        forces = {f: tw.read(f + ".force") for f in QUAD}
+        gripped = tw.read("doGripped")
+        c0, t0 = tw.object_pose("cube")[0], tw.tcp_pose().position
+        tw.run_motion("MoveL", "lift", 0.2)       # 100 mm straight up
+        tw.step(80)                               # ~1 s hanging
+        c1, t1 = tw.object_pose("cube")[0], tw.tcp_pose().position
+        rel = [(c1[i] - c0[i]) - (t1[i] - t0[i]) for i in range(3)]
+        return forces, gripped, rel, t1[2] - t0[2], tw.read("slip")
+
+
+def test_arm_lifts_the_cube_held_by_4_x_25_n_within_1_mm():
+    forces, gripped, rel, rise, slip = arm_grip_and_lift(ARM)
+    assert all(abs(v - 25.0) <= 2.5 for v in forces.values()) and gripped, forces
+    assert MU * sum(forces.values()) >= 3 * SPECS["quad"].weight
+    assert rise == pytest.approx(0.1, abs=0.001)
+    assert math.hypot(*rel) < 0.001 and not slip, (rel, slip)
+
+
+def test_arm_drops_the_cube_held_under_0_7x_its_weight_with_slip(tmp_path):
+    station = weak_station(tmp_path, "o2_quad_25n_arm", {f: 0.2 for f in QUAD})
+    forces, gripped, rel, rise, slip = arm_grip_and_lift(station)
+    assert all(abs(v - 0.2) <= 0.02 for v in forces.values()) and gripped, forces
+    assert MU * sum(forces.values()) < 0.7 * SPECS["quad"].weight
+    assert rel[2] < -0.05 and slip, (rel, slip)   # left on the table, 100 mm below the fingers
+
+
+def test_twin_check_lifts_with_the_arm(tmp_path):
+    proc, report = twin_check(ARM, tmp_path)
+    assert proc.returncode == 0 and report["verdict"] == "PASS", proc.stdout[-3000:]
+    assert any(c["measure"] == "lift" and c["level"] == "PASS" for c in report["checks"]), proc.stdout[-2000:]
