@@ -278,14 +278,46 @@ class ModbusServer:
         finally:
             self._run_steps()
 
-    def _turn(self) -> None:
-        clock = self.clock
-        now = clock()
+    def _limit(self, now: float) -> int:
+        """This step period's budget of requests (a new period starts the count again, scaled to how late the
+        simulation runs)."""
         if now >= self._window + self.step_period:
             self._window, self._used, self._busy = now, 0, 0.0
             if self.behind is not None:
                 self.scale = max(MIN_SCALE, self.scale * 0.5) if self.behind() else min(1.0, self.scale * 1.25)
-        limit = max(2, int(self.requests_per_step * self.scale))
+        return max(2, int(self.requests_per_step * self.scale))
+
+    def answer_lone(self, conn: "_Connection", data: bytes) -> bool:
+        """The common case, answered at once: `data` is one whole request from an idle connection while nobody
+        else waits and the budget has room (a PLC's scan). What a turn would do for it, without the turn's
+        round-robin; False (nothing done) for anything else, which takes the general path."""
+        if self._scheduled is not None or self._fresh or self._backlog or len(data) < 7:
+            return False
+        tid, pid, length, unit = _HDR.unpack_from(data, 0)
+        if pid != 0 or not 2 <= length <= MAX_LENGTH or len(data) != 6 + length:
+            return False
+        clock = self.clock
+        t0 = clock()
+        if self._used >= self._limit(t0):
+            return False
+        hold = self._hold_steps
+        if hold is not None:
+            hold()
+        try:
+            conn.answer_one(tid, unit, data[7:])
+            self._used += 1
+            if self.on_request is not None:
+                self.on_request(conn.peer, conn.clock_only)
+            self._busy += clock() - t0
+        finally:
+            if hold is not None:
+                self._run_steps()
+        return True
+
+    def _turn(self) -> None:
+        clock = self.clock
+        now = clock()
+        limit = self._limit(now)
         backlog_limit = limit - max(1, limit // 10)
         share = self.serve_share * self.scale * self.step_period
         t0 = now
@@ -462,6 +494,8 @@ class _Connection(asyncio.Protocol):
         if self.closed:
             return
         fresh = not self.buf
+        if fresh and not self.waiting and not self.queued and not self.writing_paused and self.server.answer_lone(self, data):
+            return
         self.buf += data
         if self.waiting:  # a deferred answer first: keep what comes, answer it afterwards
             if len(self.buf) >= READ_BACKLOG:
@@ -489,12 +523,28 @@ class _Connection(asyncio.Protocol):
         buf = self.buf
         return len(buf) >= 7 and len(buf) == 6 + _HDR.unpack_from(buf, 0)[2]
 
+    def _respond(self, tid: int, unit: int, request: bytes) -> bytes | None:
+        """The answer's frame to one request, or None when it waits for lockstep steps (`_finish` sends it)."""
+        response = self.server.handle(unit, request, self.hold, self.read_only)
+        if isinstance(response, Deferred):
+            self.waiting = True
+            self.server.backend.when_stepped(lambda: self._finish(tid, unit, response))
+            return None
+        return _HDR.pack(tid, 0, len(response) + 1, unit) + response
+
+    def answer_one(self, tid: int, unit: int, request: bytes) -> None:
+        """A lone request (`ModbusServer.answer_lone`), the buffer empty: answered, or waiting for its steps."""
+        self.clock_only = self.server.pdus.clock_only(request)
+        frame = self._respond(tid, unit, request)
+        self.last_request = self.loop.time()
+        if frame is not None:
+            self.transport.write(frame)  # may call pause_writing
+
     def answer(self, limit: int) -> int:
         """Answer up to `limit` complete requests at the front of the buffer; returns how many."""
         buf = self.buf
         out = []
         pos, n = 0, len(buf)
-        handle = self.server.handle
         count = 0
         bad = ""
         clock = self.server.pdus.clock_only
@@ -512,14 +562,12 @@ class _Connection(asyncio.Protocol):
             request = bytes(memoryview(buf)[pos + 7:pos + 6 + length])
             if self.clock_only and not clock(request):
                 self.clock_only = False
-            response = handle(unit, request, self.hold, self.read_only)
+            frame = self._respond(tid, unit, request)
             pos += 6 + length
             count += 1
-            if isinstance(response, Deferred):  # answered once the lockstep steps are done; later ones wait
-                self.waiting = True
-                self.server.backend.when_stepped(lambda: self._finish(tid, unit, response))
+            if frame is None:  # answered once the lockstep steps are done; later ones wait
                 break
-            out.append(_HDR.pack(tid, 0, len(response) + 1, unit) + response)
+            out.append(frame)
         if pos:
             del buf[:pos]
             self.last_request = self.loop.time()
