@@ -418,15 +418,6 @@ KNOWN = {
                             "twin keeps 4 substeps and gives no warning at load (twin check FAILs force, naming the range)",
     ("contact", "quad_20ms"): "at a 20 ms step the step before f_px's and f_py's flags rose they were 0.096 mm into "
                               "the cube (1 mm of travel per step)",
-    ("creep", "pivot"): "a 100 g cylinder lying on a static box table rolls off at rest (6 mm/s^2 from the first step), "
-                        "rebounding between the open levers: 9.4 mm in 5 s after 0.5 s (limit 0.1 mm)",
-    ("status", "pivot"): "the levers closing on the rolling cylinder: status 0/2 alternating for 73-78 steps after "
-                         "touching (limit 10)",
-    ("still", "pivot"): "the levers closing on the rolling cylinder: `moving` in 38-41 of the 417 hold steps, "
-                        "spread 0.29-0.34 mrad",
-    ("status", "pivot_now"): "closed at once (the cylinder still): status 2 -> 0 -> 2 flicker, the last 0 13 steps "
-                             "after touching (settles at 20-21 steps; limit 10)",
-    ("still", "pivot_now"): "closed at once: `moving` in 3-4 steps of the hold, spread 0.125 mrad",
 }
 
 
@@ -583,9 +574,11 @@ def test_twin_check_fails_the_chucks_jaw_forces_as_statics_does(key, tmp_path):
     assert _fails(report) == {(f, "force") for f in off}, proc.stdout[-3000:]
 
 
-def test_twin_check_fails_the_rolling_cylinder_at_rest(tmp_path):
+def test_twin_check_passes_the_cylinder_lying_still_on_its_table(tmp_path):
+    # (pybullet alone rolls a cylinder lying on a flat support off it within seconds, from rest; the twin's cylinders
+    # resist rolling as plastic does on steel, and the doctor's creep check would catch one that rolls)
     proc, report = twin_check(GRIPPERS / SPECS["pivot"].station, tmp_path)
-    assert proc.returncode == 1 and ("part", "creep") in _fails(report), proc.stdout[-3000:]
+    assert proc.returncode == 0 and not _fails(report), proc.stdout[-3000:]
 
 
 def test_twin_check_catches_a_grip_under_its_parts_weight(tmp_path):

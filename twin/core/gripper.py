@@ -815,6 +815,11 @@ class Gripper:
         self._reset_sums()
         self._grip_rule()
 
+    def touched_bodies(self) -> set[int]:
+        """The targets (body ids) a finger touches, as the last step sensed them."""
+        targets = self.targets
+        return {targets[t] for f in self.state.fingers.values() for t in f.contacts}
+
     def _grip_rule(self) -> None:
         """Grip, attachment and slip from the fingers' contacts and forces of the step just sensed."""
         held = self.state.gripped

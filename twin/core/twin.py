@@ -157,6 +157,8 @@ class Twin:
                     gripper.measure(k == substeps - 1)
             self.step_count += 1
             self.gripper.sense()
+            if world.rolling:  # (round parts in the cell)
+                world.free_rolling(gripper.touched_bodies())
             self._publish(gripper.along)
             world.stasis.after_step(self._machine_still)
             for device in self.devices:

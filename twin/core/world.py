@@ -31,6 +31,12 @@ from .native_output import quiet_native_output
 ROBOT_PREFIX = "robot/"
 COLLISION_MARGIN = 0.0001  # m: pybullet's default 1 mm margin rounds box corners (contact 0.4-0.7 mm late)
 CYLINDER_MARGIN = 0.001  # m: pybullet's own, kept for cylinders (rims round by 0.41 mm; sides are exact)
+ROLLING_RESISTANCE = 3e-4  # m: a loose cylinder's rolling friction while no finger touches it (pybullet's, a lever:
+# the torque that resists rolling is it times the normal force times the other body's friction, 0.03-0.3 mm on a
+# support of friction 0.1-1, as plastic or wood rolls on steel). pybullet rolls a cylinder lying still on a flat
+# support by itself (a 100 g, 40 mm one off a table within 2 s, from rest): a lever of 0.001-0.03 mm, depending on its
+# size, holds it. Between fingers it has none: there it would act at every finger's contact too (0.3 mm times 60 N),
+# and hold a squeezed peg tilted where the fingers' push left it
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
 SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
 # rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
@@ -203,6 +209,8 @@ def create_body(c, body: Body) -> int:
     c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
     if body.mass > 0:  # friction anchors: a part held or resting by friction stays where friction holds it (without
         c.changeDynamics(uid, -1, frictionAnchor=1)  # them the solver's friction drifts: a squeezed box walks)
+        if body.shape == "cylinder":  # a round part lying still stays where it lies (World.free_rolling)
+            c.changeDynamics(uid, -1, rollingFriction=ROLLING_RESISTANCE)
     if body.shape in ("box", "ring"):  # sharp corners; a cylinder keeps pybullet's margin (a thin one makes a
         c.changeDynamics(uid, -1, collisionMargin=COLLISION_MARGIN)  # squeezed one creep; its rims err 0.4 mm)
     return uid
@@ -321,6 +329,19 @@ class World:
 
         loose = [self.body_ids[b.name] for b in (*station.fixtures, *station.targets) if b.dynamic]
         self.stasis = Stasis(self.client, self.machine, loose)  # loose bodies frozen while the cell rests
+        # loose cylinders (targets): their rolling friction as it is now (ROLLING_RESISTANCE, or 0 between fingers)
+        self.rolling = {self.body_ids[b.name]: ROLLING_RESISTANCE for b in station.targets
+                        if b.dynamic and b.shape == "cylinder"}
+
+    def free_rolling(self, touched: set[int]) -> None:
+        """The loose cylinders the fingers touch (body ids) roll as the fingers let them; the others resist rolling
+        (ROLLING_RESISTANCE): a round part lying still stays where it lies, one squeezed settles where the fingers
+        put it. Applied from the next step."""
+        for uid, now in self.rolling.items():
+            want = 0.0 if uid in touched else ROLLING_RESISTANCE
+            if want != now:
+                self.client.changeDynamics(uid, -1, rollingFriction=want)
+                self.rolling[uid] = want
 
     def _build(self, station: Station, gripper_root: str) -> None:
         self.body_ids: dict[str, int] = {}
