@@ -521,13 +521,12 @@ shape = "plane"
             assert f["status"][-1][0] == status, f
             assert f["force"] == pytest.approx(effort, rel=0.1), f
         # penetration is the overlap into the part, positive: with three fingers 120 degrees apart the part's offset
-        # cancels in the mean, so the mean depth is what the mean pressing position says (within 15 um: the closing
-        # push leaves the peg tilted by about 0.4 mrad, so along the 50 mm the fingers touch it the overlap varies by
-        # 20 um, and the table gives the deepest, of the hold)
+        # cancels in the mean, so the mean depth is what the mean pressing position says (within 10 um: the part
+        # also tilts a little in the grip, and the table gives the deepest of the hold)
         depth = [peg_r - f["position"] if mode == "outside" else f["position"] + face - bore_r for f in g["fingers"]]
         assert sum(depth) / 3 > 0
         assert all(f["penetration"] >= 0 for f in g["fingers"])
-        assert sum(f["penetration"] for f in g["fingers"]) / 3 == pytest.approx(sum(depth) / 3, abs=15e-6)
+        assert sum(f["penetration"] for f in g["fingers"]) / 3 == pytest.approx(sum(depth) / 3, abs=10e-6)
         for f in g["fingers"]:
             assert any(ln.split()[3:5] == [f["finger"], "penetration:"] and "into the part" in ln
                        for ln in lines(text, "PASS") if f"{target} {mode}" in ln), text

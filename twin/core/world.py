@@ -31,12 +31,13 @@ from .native_output import quiet_native_output
 ROBOT_PREFIX = "robot/"
 COLLISION_MARGIN = 0.0001  # m: pybullet's default 1 mm margin rounds box corners (contact 0.4-0.7 mm late)
 CYLINDER_MARGIN = 0.001  # m: pybullet's own, kept for cylinders (rims round by 0.41 mm; sides are exact)
-ROLLING_RESISTANCE = 3e-4  # m: a loose cylinder's rolling friction while no finger touches it (pybullet's, a lever:
-# the torque that resists rolling is it times the normal force times the other body's friction, 0.03-0.3 mm on a
-# support of friction 0.1-1, as plastic or wood rolls on steel). pybullet rolls a cylinder lying still on a flat
-# support by itself (a 100 g, 40 mm one off a table within 2 s, from rest): a lever of 0.001-0.03 mm, depending on its
-# size, holds it. Between fingers it has none: there it would act at every finger's contact too (0.3 mm times 60 N),
-# and hold a squeezed peg tilted where the fingers' push left it
+ROLLING_RESISTANCE = 3e-4  # m: the rolling friction of a loose cylinder lying on its side that no finger touches
+# (pybullet's, a lever: the torque that resists rolling is it times the normal force times the other body's friction,
+# 0.03-0.3 mm on a support of friction 0.1-1, as plastic or wood rolls on steel). pybullet rolls a cylinder lying
+# still on a flat support by itself (a 100 g, 40 mm one off a table within 2 s, from rest): a lever of 0.001-0.03 mm,
+# depending on its size, holds it. A cylinder standing on its end cannot roll and has none; between fingers neither
+# (there it would act at every finger's contact, 0.3 mm times their force, and change how a squeezed part settles)
+LYING = math.cos(math.radians(45.0))  # a cylinder whose axis is nearer the horizontal than this lies on its side
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
 SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
 # rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
@@ -209,8 +210,6 @@ def create_body(c, body: Body) -> int:
     c.changeDynamics(uid, -1, lateralFriction=body.friction, restitution=0.0)
     if body.mass > 0:  # friction anchors: a part held or resting by friction stays where friction holds it (without
         c.changeDynamics(uid, -1, frictionAnchor=1)  # them the solver's friction drifts: a squeezed box walks)
-        if body.shape == "cylinder":  # a round part lying still stays where it lies (World.free_rolling)
-            c.changeDynamics(uid, -1, rollingFriction=ROLLING_RESISTANCE)
     if body.shape in ("box", "ring"):  # sharp corners; a cylinder keeps pybullet's margin (a thin one makes a
         c.changeDynamics(uid, -1, collisionMargin=COLLISION_MARGIN)  # squeezed one creep; its rims err 0.4 mm)
     return uid
@@ -329,16 +328,23 @@ class World:
 
         loose = [self.body_ids[b.name] for b in (*station.fixtures, *station.targets) if b.dynamic]
         self.stasis = Stasis(self.client, self.machine, loose)  # loose bodies frozen while the cell rests
-        # loose cylinders (targets): their rolling friction as it is now (ROLLING_RESISTANCE, or 0 between fingers)
-        self.rolling = {self.body_ids[b.name]: ROLLING_RESISTANCE for b in station.targets
-                        if b.dynamic and b.shape == "cylinder"}
+        # loose cylinders (targets): their rolling friction as it is now (ROLLING_RESISTANCE while lying untouched)
+        self.rolling = {self.body_ids[b.name]: 0.0 for b in station.targets if b.dynamic and b.shape == "cylinder"}
+        g = math.sqrt(sum(v * v for v in station.gravity))
+        self._down = tuple(v / g for v in station.gravity) if g else (0.0, 0.0, -1.0)
+        self.free_rolling(set())
 
     def free_rolling(self, touched: set[int]) -> None:
-        """The loose cylinders the fingers touch (body ids) roll as the fingers let them; the others resist rolling
-        (ROLLING_RESISTANCE): a round part lying still stays where it lies, one squeezed settles where the fingers
-        put it. Applied from the next step."""
+        """Loose cylinders lying on their side that no finger touches resist rolling (ROLLING_RESISTANCE): one lying
+        still stays where it lies. Standing on an end, or between fingers (`touched`, body ids), they have no rolling
+        friction: nothing for it to do there but change how a squeezed part settles. Applied from the next step."""
+        pose_of, (dx, dy, dz) = self.client.getBasePositionAndOrientation, self._down
         for uid, now in self.rolling.items():
-            want = 0.0 if uid in touched else ROLLING_RESISTANCE
+            want = 0.0
+            if uid not in touched:
+                x, y, z, w = pose_of(uid)[1]  # the cylinder's axis (its local z) in the world, against the vertical
+                if abs(2 * (x * z + w * y) * dx + 2 * (y * z - w * x) * dy + (1 - 2 * (x * x + y * y)) * dz) < LYING:
+                    want = ROLLING_RESISTANCE
             if want != now:
                 self.client.changeDynamics(uid, -1, rollingFriction=want)
                 self.rolling[uid] = want
