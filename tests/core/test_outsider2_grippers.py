@@ -21,6 +21,8 @@ Geometry, as the URDFs are written (tests/grippers/o2_*/gripper.urdf):
 - o2_lever3_mimic: three revolute levers at 120 degrees, ONE 3 N m input, two 1:1 mimics: 1 N m per lever by
   virtual work. Pivots at radius 45 mm, 70 mm up; each 60 mm lever's inner tip corner at radius 0.045 - 0.06
   sin(theta), 70 - 60 cos(theta) mm up: it meets the 60 mm disc's side at sin(theta) = 0.25.
+- o2_quad_25n_bore: the same four fingers standing in a ring's 80 mm bore (12 faces, one facing each finger), a
+  pad's outer face at q + 10 mm: touch at q = 0.030, statics 25 N each (status 1).
 - o2_heavy_2000n: 2000 N jaws of 5 kg, inner faces at x = +q_a and -q_b; a 120 mm wide block of 20 kg.
 - o2_feather_1n: 1 N fingers of 5 g, inner faces at +/- q, a 15 mm cube of 5 g.
 - o2_sloppy_export: 1e-9 kg m^2 on a 30 g finger with velocity 0, a finger with no inertial and no effort.
@@ -158,6 +160,13 @@ def lever3_penetration(tw):
             for f, deg in (("lever_1", 0), ("lever_2", 120), ("lever_3", 240))}
 
 
+def quad_bore_penetration(tw):
+    # the 80 mm bore's faces at 40 mm, one facing each finger; a pad's outer face at q + 10 mm
+    (x, y, _), _ = tw.object_pose("ring")
+    return {f: (tw.read(f + ".actual") + 0.010) - (0.040 + x * u[0] + y * u[1])
+            for f, u in (("f_px", _unit(0)), ("f_py", _unit(90)), ("f_nx", _unit(180)), ("f_ny", _unit(270)))}
+
+
 def bore_penetration(tw):
     # 12-gon bore, 30 mm to each face, a face facing each jaw; the jaw's outer face at q1 + 10 mm
     q = tw.read("f1.actual")
@@ -220,6 +229,7 @@ def brick_penetration(tw):
 BRICK_ARM = LEVER_LEN * math.cos(math.asin(0.01 / LEVER_LEN))
 
 
+QUAD = ("f_px", "f_py", "f_nx", "f_ny")
 SPECS = {
     "quad": Spec("o2_quad_25n", "cube", ["f_px", "f_py", "f_nx", "f_ny"],
                  {f: 0.0 for f in ("f_px", "f_py", "f_nx", "f_ny")}, {f: 25.0 for f in ("f_px", "f_py", "f_nx", "f_ny")},
@@ -404,6 +414,9 @@ def measured(key) -> Run:
 # the lying cylinder rolls off at rest (test_resting_part...[pivot]): its grip is also measured closing at once
 SPECS["pivot_now"] = replace(SPECS["pivot"], settle=0.0, rest=0.0)
 # the quad on its cube placed 2 mm and -1.5 mm off centre (x, y): the first fingers push it over to the others
+SPECS["quad_bore"] = replace(SPECS["quad"], station="o2_quad_25n_bore", target="ring", close={f: 0.04 for f in QUAD},
+                             penetration=quad_bore_penetration, status=1, lift=None,
+                             weight=math.pi / 4 * (0.12 ** 2 - 0.08 ** 2) * 0.02 * 2700 * G)
 SPECS["quad_off"] = replace(SPECS["quad"], station="o2_quad_25n_off", centred=False)
 # a 20 ms step (the station's `step`, 4 substeps): what a newcomer may choose for a slow cell
 SPECS["quad_20ms"] = replace(SPECS["quad"], edits=(("[station]\n", "[station]\nstep = 0.02\n"),))
@@ -426,6 +439,11 @@ KNOWN = {
     ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
     ("contact", "bore"): "opening into the bore, the step before the jaws' contact flags rose they stood 0.08 mm into the "
                          "bore's wall (all three; 0.06 mm when it rose): the flag is a step late",
+    ("force", "quad_bore"): "four independent 25 N fingers opening into an 80 mm bore: 18.0 / 21.1 / 24.8 / 25.0 N "
+                            "(f_px 28 % short, f_py 15 %; the ring free on the floor, opposite fingers unequal)",
+    ("status", "quad_bore"): "in the bore f_py reads 0 and 1 in turn for 20 steps after touching (0x1 1x2 0x2 1x1 0x2 "
+                             "1x8 0x4 1x408), f_ny 9",
+    ("still", "quad_bore"): "in the bore f_py is `moving` in 4 steps of the hold, its actual spread 0.12 mm",
     ("contact", "quad_off"): "the cube 2 mm / -1.5 mm off centre, pushed over by f_px and f_ny: the step before f_py's "
                              "contact flag rose its pad overlapped the cube's outline by 0.15 mm (f_nx 0.04 mm)",
     ("force", "quad_20ms"): "with `step = 0.02` the derived stiffness falls to 720 N/m (25 N at 35 mm past the part) and "
@@ -588,7 +606,7 @@ def test_twin_check_passes_the_grippers_whose_measures_pass(key, tmp_path):
         assert any(c["measure"] == "lift" and c["level"] == "PASS" for c in report["checks"]), proc.stdout[-2000:]
 
 
-@pytest.mark.parametrize("key", ["chuck", "bore", "lever3"])
+@pytest.mark.parametrize("key", ["chuck", "bore", "lever3", "quad_bore"])
 def test_twin_check_fails_the_mimic_chucks_as_statics_does(key, tmp_path):
     proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
     assert proc.returncode == 1 and report["verdict"] == "FAIL"
@@ -596,7 +614,8 @@ def test_twin_check_fails_the_mimic_chucks_as_statics_does(key, tmp_path):
     # what else it fails is what was measured failing above (the levers' flicker and push)
     spec, run = SPECS[key], measured(key)
     off = {(f, "force") for f in spec.fingers if abs(run.force[f][1] - spec.force[f]) > 0.1 * spec.force[f]}
-    also = {(f, "status") for f in spec.fingers} | {("lever_1", "moving"), ("grip", "push")} if key == "lever3" else set()
+    also = {"lever3": {(f, "status") for f in spec.fingers} | {("lever_1", "moving"), ("grip", "push")},
+            "quad_bore": {("f_py", "status"), ("f_py", "noise"), ("f_py", "moving")}}.get(key, set())
     assert off and off <= _fails(report) <= off | also, proc.stdout[-3000:]
 
 
@@ -661,7 +680,7 @@ def test_same_station_inputs_and_steps_give_the_same_result_bit_for_bit(key):
 # ---- every face shows the same value ------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("key, writes, steps", [
-    ("heavy", {"block.present": 0, "jaw_a": 0.0, "jaw_b": 0.0, "lift": 0.1}, 120),  # 2000 N / 8000 N into their stops
+    ("heavy", {"block.present": 0, "jaw_a": 0.0, "jaw_b": 0.0, "lift": 0.1}, 200),  # 2000 N / 8000 N into their stops
     ("chuck", {"f1": 0.0}, 60),                                                       # the mimic jaws on the disc
 ])
 def test_modbus_reads_what_the_simulation_api_reads(key, writes, steps):
@@ -686,10 +705,50 @@ def test_modbus_reads_what_the_simulation_api_reads(key, writes, steps):
         assert lo * 1000 <= wire[i + ".actual"] <= hi * 1000 and lo <= api[i + ".actual"] <= hi
 
 
+def test_opc_ua_reads_what_the_simulation_api_reads_with_the_jaws_in_their_stops():
+    import re
+    from asyncua import ua
+    from asyncua.sync import Client
+
+    spec = SPECS["heavy"]
+    writes = {"block.present": False, "jaw_a": 0.0, "jaw_b": 0.0, "lift": 0.1}
+    names = [i + ".actual" for i in spec.ranges] + [f + ".force" for f in spec.fingers] + ["jaw_a.effort"]
+    with Twin.from_station(GRIPPERS / spec.station) as tw:
+        for name, value in writes.items():
+            tw.write(name, value)
+        tw.step(200)
+        api = {n: tw.read(n) for n in names}
+    server = subprocess.Popen([sys.executable, "-m", "twin_app.cli", "serve", str(GRIPPERS / spec.station), "--lockstep",
+                               "--opcua", "0", "--no-modbus"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              env={**os.environ, "PYTHONPATH": str(ROOT)})
+    try:
+        url = None
+        for line in server.stdout:
+            m = re.search(r"OPC UA listening on (\S+)", line)
+            if m:
+                url = m.group(1)
+                break
+        assert url, "the server never said where it listens"
+        with Client(url, timeout=10) as client:
+            ns = client.get_namespace_index("urn:gripper-twin:station:o2_heavy_2000n")
+            for name, value in writes.items():
+                kind = ua.VariantType.Boolean if isinstance(value, bool) else ua.VariantType.Double
+                client.get_node(f"ns={ns};s={name}").write_value(ua.DataValue(ua.Variant(value, kind)))
+            for _ in range(4):   # in chunks well under asyncua's 1 s keep-alive
+                client.get_node(f"ns={ns};s=Sim").call_method(client.get_node(f"ns={ns};s=Sim.Advance"),
+                                                              ua.Variant(50, ua.VariantType.UInt32))
+            wire = {n: client.get_node(f"ns={ns};s={n}").read_value() for n in names}
+    finally:
+        server.terminate()
+        server.wait(10)
+    assert wire == api      # SI units, not scaled: the same doubles, bit for bit
+    for i, (lo, hi) in spec.ranges.items():
+        assert lo <= wire[i + ".actual"] <= hi
+
+
 # ---- on the shipped arm: the robot lifts ---------------------------------------------------------------------------
 
 ARM = GRIPPERS / "o2_quad_25n_arm"
-QUAD = ("f_px", "f_py", "f_nx", "f_ny")
 
 
 def arm_grip_and_lift(station):
