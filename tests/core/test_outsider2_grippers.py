@@ -653,8 +653,6 @@ def test_sloppy_finger_without_an_inertial_block_is_warned_about(tmp_path):
     assert any(c["level"] == "WARN" and c["who"] == "finger_b" and c["measure"] == "mass" for c in report["checks"])
 
 
-@pytest.mark.xfail(strict=True, reason="a URDF velocity limit of 0 (slide_a) is silently replaced by the 0.1 m/s "
-                   "default (twin info: finger_a 0.1 m/s), no warning and no error naming the joint")
 def test_sloppy_velocity_limit_of_zero_is_warned_about_or_refused():
     proc = twin_info(GRIPPERS / "o2_sloppy_export")
     said = [ln for ln in (proc.stderr + proc.stdout).splitlines()

@@ -93,7 +93,7 @@ LOST_WATCH_STEPS = 25  # a gripped part no finger presses on any more, and that 
 # slip this many steps more (0.3 s at 12 ms): a dropped part leaves the fingers within a step
 RELEASE_SHARE = 0.25  # a grip lasts while every finger presses with this share of grip_force (no flicker)
 CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
-_warned_efforts: set[str] = set()  # each unreachable effort warned of once per process
+_warned_efforts: set[str] = set()  # each unreachable or defaulted limit warned of once per process
 STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
 
 
@@ -199,7 +199,7 @@ class Gripper:
         self._pressing_none = {name: False for name in self.names}  # (read only: no drive's finger presses)
         self._derive_drives(stiffness_given)
         self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
-        self.effort_notes = self._unreachable_efforts()
+        self.effort_notes = self._defaulted_limits(mechanism) + self._unreachable_efforts()
         # how many springy drives move each drive's fingers in series (a fine axis and the carriage it rides on: 2;
         # a drive stiffer than the step resolves holds its command rigidly, and is no spring in the chain)
         springy = {name for name, d in self.drives.items() if d.stiffness <= d.limit}
@@ -369,6 +369,28 @@ class Gripper:
             # with it would overshoot every substep (a limit cycle: a squeezed heavy ring rocked by its fingers)
             self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * own / (share * h), mass, limit,
                                       own)
+
+    def _defaulted_limits(self, mechanism: Mechanism) -> list[str]:
+        """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,
+        as exporters leave them) nor the station gives: the default the drive runs with, and where to give the real
+        one."""
+        notes = []
+        for inp in mechanism.inputs:
+            o = self.spec.joints.get(inp.name)
+            d = self.drives[inp.name]
+            for what, urdf, given, value, unit in (
+                    ("velocity", inp.velocity, o and o.velocity, d.velocity, "m/s" if inp.unit == "m" else "rad/s"),
+                    ("effort", inp.effort, o and o.effort, d.effort, "N" if inp.unit == "m" else "N m")):
+                if urdf or given:
+                    continue
+                note = (f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing or 0): "
+                        f"its drive runs with {value:g} {unit}; give the real one in the URDF's <limit {what}=...> or in "
+                        f"[gripper.joints.{inp.name}] {what}")
+                notes.append(note)
+                if note not in _warned_efforts:
+                    _warned_efforts.add(note)
+                    logging.getLogger("twin").warning("warning: %s", note)
+        return notes
 
     def _unreachable_efforts(self) -> list[str]:
         """One warning line per drive whose effort it cannot reach anywhere in its joint's range: its full-force
