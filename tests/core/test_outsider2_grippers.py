@@ -805,3 +805,45 @@ def test_a_gripper_starting_inside_a_fixture_is_refused_or_warned_about(tmp_path
     said = [ln for ln in (info.stdout + info.stderr).splitlines() if "table" in ln and ("error" in ln or "warning" in ln)]
     proc, report = twin_check(station, tmp_path)
     assert info.returncode != 0 or said or (report and report["verdict"] != "PASS"), (info.stdout[-500:], proc.stdout[-1500:])
+
+
+# ---- 2000 N jaws on the shipped arm, carrying 20 kg ---------------------------------------------------------------
+
+HEAVY_ARM = GRIPPERS / "o2_heavy_2000n_arm"
+
+
+def heavy_arm_run(movej_speed=None):
+    """Grip the 20 kg block, lift it 100 mm (MoveL 0.2 m/s), optionally carry it across the cell (MoveJ), hold 1 s."""
+    with Twin.from_station(HEAVY_ARM) as tw:
+        tw.step(20)
+        tw.run_motion("MoveL", "grip", 0.1)
+        for f in ("jaw_a", "jaw_b"):
+            tw.write(f, 0.0)
+        tw.step(80)
+        q0 = {f: tw.read(f + ".actual") for f in ("jaw_a", "jaw_b")}
+        d0 = math.dist(tw.object_pose("block")[0], tw.tcp_pose().position)
+        tw.run_motion("MoveL", "lift", 0.2)
+        if movej_speed:
+            tw.run_motion("MoveJ", "away", movej_speed)
+        tw.step(80)
+        return {"force": {f: tw.read(f + ".force") for f in ("jaw_a", "jaw_b")},
+                "effort": {f: tw.read(f + ".effort") for f in ("jaw_a", "jaw_b")},
+                "shift": {f: tw.read(f + ".actual") - q0[f] for f in ("jaw_a", "jaw_b")},
+                "moved": math.dist(tw.object_pose("block")[0], tw.tcp_pose().position) - d0,
+                "slip": tw.read("slip"), "gripped": tw.read("doGripped")}
+
+
+def test_arm_lifts_the_20_kg_block_in_2000_n_jaws_within_1_mm():
+    run = heavy_arm_run()
+    assert all(abs(v - 2000.0) <= 200.0 for v in run["force"].values()), run
+    assert abs(run["moved"]) < 0.001 and not run["slip"] and run["gripped"], run
+
+
+@pytest.mark.xfail(strict=True, reason="carried across the cell (MoveJ at 7 m/s) the jaws, both saturated at 2000 N, "
+                   "let the block and themselves slide 14 mm together along the closing axis (slip raised), and then "
+                   "each reads 2533 / 2530 N of contact force, steady, while its drive applies 2000 N (MoveJ at 2 m/s: "
+                   "30 mm, 2156 / 2133 N; at 0.5 m/s: 1.5 mm, 2082 / 2000 N)")
+def test_after_carrying_the_block_each_jaw_presses_with_its_drives_effort():
+    run = heavy_arm_run(7.0)
+    assert run["gripped"]
+    assert all(abs(v - 2000.0) <= 200.0 for v in run["force"].values()), run
