@@ -420,6 +420,14 @@ SPECS["quad_bore"] = replace(SPECS["quad"], station="o2_quad_25n_bore", target="
 SPECS["quad_off"] = replace(SPECS["quad"], station="o2_quad_25n_off", centred=False)
 # a 20 ms step (the station's `step`, 4 substeps): what a newcomer may choose for a slow cell
 SPECS["quad_20ms"] = replace(SPECS["quad"], edits=(("[station]\n", "[station]\nstep = 0.02\n"),))
+# fingers as fast as exported URDFs often say (0.5 m/s: 6 mm a step), set in the station
+def _fast(names):
+    return (("[[targets]]", "".join(f"[gripper.joints.{n}]\nvelocity = 0.5\n\n" for n in names) + "[[targets]]"),)
+
+
+SPECS["quad_fast"] = replace(SPECS["quad"], edits=_fast(QUAD))
+SPECS["feather_fast"] = replace(SPECS["feather"], edits=_fast(("tip_a", "tip_b")))
+SPECS["heavy_fast"] = replace(SPECS["heavy"], edits=_fast(("jaw_a", "jaw_b")))
 ALL = list(SPECS)
 
 
@@ -444,6 +452,14 @@ KNOWN = {
     ("status", "quad_bore"): "in the bore f_py reads 0 and 1 in turn for 20 steps after touching (0x1 1x2 0x2 1x1 0x2 "
                              "1x8 0x4 1x408), f_ny 9",
     ("still", "quad_bore"): "in the bore f_py is `moving` in 4 steps of the hold, its actual spread 0.12 mm",
+    ("status", "quad_fast"): "fingers at 0.5 m/s (station velocity): status 2 only 11-12 steps after touching (the "
+                             "pads 1.1-1.3 mm into the cube the step their flags rose)",
+    ("still", "quad_fast"): "fingers at 0.5 m/s: f_px and f_py `moving` in the hold's first step",
+    ("status", "feather_fast"): "1 N fingers at 0.5 m/s on the 5 g cube: tip_b reads 2, 0, 2 and settles 14 steps after "
+                                "touching",
+    ("still", "feather_fast"): "1 N fingers at 0.5 m/s: tip_b `moving` in 2 steps of the hold",
+    ("push", "feather_fast"): "1 N fingers at 0.5 m/s from equal 7.5 mm gaps: the centred 5 g cube is pushed 3.0 mm "
+                              "(tip_b 2.2 mm into it the step its flag rose)",
     ("contact", "quad_off"): "the cube 2 mm / -1.5 mm off centre, pushed over by f_px and f_ny: the step before f_py's "
                              "contact flag rose its pad overlapped the cube's outline by 0.15 mm (f_nx 0.04 mm)",
     ("force", "quad_20ms"): "with `step = 0.02` the derived stiffness falls to 720 N/m (25 N at 35 mm past the part) and "
