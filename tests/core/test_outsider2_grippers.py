@@ -798,8 +798,9 @@ def test_arm_drops_the_cube_held_under_0_7x_its_weight_with_slip(tmp_path):
     assert rel[2] < -0.05 and slip, (rel, slip)   # left on the table, 100 mm below the fingers
 
 
-def test_twin_check_lifts_with_the_arm(tmp_path):
-    proc, report = twin_check(ARM, tmp_path)
+@pytest.mark.parametrize("name", ["o2_quad_25n_arm", "o2_heavy_2000n_arm"])
+def test_twin_check_lifts_with_the_arm(name, tmp_path):
+    proc, report = twin_check(GRIPPERS / name, tmp_path)
     assert proc.returncode == 0 and report["verdict"] == "PASS", proc.stdout[-3000:]
     assert any(c["measure"] == "lift" and c["level"] == "PASS" for c in report["checks"]), proc.stdout[-2000:]
 
