@@ -462,11 +462,6 @@ KNOWN = {
                               "(tip_b 2.2 mm into it the step its flag rose)",
     ("contact", "quad_off"): "the cube 2 mm / -1.5 mm off centre, pushed over by f_px and f_ny: the step before f_py's "
                              "contact flag rose its pad overlapped the cube's outline by 0.15 mm (f_nx 0.04 mm)",
-    ("force", "quad_20ms"): "with `step = 0.02` the derived stiffness falls to 720 N/m (25 N at 35 mm past the part) and "
-                            "the fingers, 15 mm from their range's end at the cube, press 11.2-12.3 N of 25 N; the "
-                            "twin keeps 4 substeps and gives no warning at load (twin check FAILs force, naming the range)",
-    ("contact", "quad_20ms"): "at a 20 ms step the step before f_px's and f_py's flags rose they were 0.096 mm into "
-                              "the cube (1 mm of travel per step)",
     ("force", "lever3"): "one-input 3-lever revolute chuck (two 1:1 mimics), 3 N m: the levers hold 1.37 / 0.87 / "
                          "0.73 N m where virtual work gives 1 N m each",
     ("penetration", "lever3"): "lever_1 (the input) stands 0.32 mm into the disc; were the followers where the URDF's "
