@@ -447,11 +447,6 @@ KNOWN = {
     ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
     ("contact", "bore"): "opening into the bore, the step before the jaws' contact flags rose they stood 0.08 mm into the "
                          "bore's wall (all three; 0.06 mm when it rose): the flag is a step late",
-    ("force", "quad_bore"): "four independent 25 N fingers opening into an 80 mm bore: 18.0 / 21.1 / 24.8 / 25.0 N "
-                            "(f_px 28 % short, f_py 15 %; the ring free on the floor, opposite fingers unequal)",
-    ("status", "quad_bore"): "in the bore f_py reads 0 and 1 in turn for 20 steps after touching (0x1 1x2 0x2 1x1 0x2 "
-                             "1x8 0x4 1x408), f_ny 9",
-    ("still", "quad_bore"): "in the bore f_py is `moving` in 4 steps of the hold, its actual spread 0.12 mm",
     ("status", "quad_fast"): "fingers at 0.5 m/s (station velocity): status 2 only 11-12 steps after touching (the "
                              "pads 1.1-1.3 mm into the cube the step their flags rose)",
     ("still", "quad_fast"): "fingers at 0.5 m/s: f_px and f_py `moving` in the hold's first step",
@@ -460,8 +455,6 @@ KNOWN = {
     ("still", "feather_fast"): "1 N fingers at 0.5 m/s: tip_b `moving` in 2 steps of the hold",
     ("push", "feather_fast"): "1 N fingers at 0.5 m/s from equal 7.5 mm gaps: the centred 5 g cube is pushed 3.0 mm "
                               "(tip_b 2.2 mm into it the step its flag rose)",
-    ("contact", "quad_off"): "the cube 2 mm / -1.5 mm off centre, pushed over by f_px and f_ny: the step before f_py's "
-                             "contact flag rose its pad overlapped the cube's outline by 0.15 mm (f_nx 0.04 mm)",
     ("force", "lever3"): "one-input 3-lever revolute chuck (two 1:1 mimics), 3 N m: the levers hold 1.37 / 0.87 / "
                          "0.73 N m where virtual work gives 1 N m each",
     ("penetration", "lever3"): "lever_1 (the input) stands 0.32 mm into the disc; were the followers where the URDF's "
@@ -617,7 +610,7 @@ def test_twin_check_passes_the_grippers_whose_measures_pass(key, tmp_path):
         assert any(c["measure"] == "lift" and c["level"] == "PASS" for c in report["checks"]), proc.stdout[-2000:]
 
 
-@pytest.mark.parametrize("key", ["chuck", "bore", "lever3", "quad_bore"])
+@pytest.mark.parametrize("key", ["chuck", "bore", "lever3"])
 def test_twin_check_fails_the_mimic_chucks_as_statics_does(key, tmp_path):
     proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
     assert proc.returncode == 1 and report["verdict"] == "FAIL"
@@ -626,8 +619,15 @@ def test_twin_check_fails_the_mimic_chucks_as_statics_does(key, tmp_path):
     spec, run = SPECS[key], measured(key)
     off = {(f, "force") for f in spec.fingers if abs(run.force[f][1] - spec.force[f]) > 0.1 * spec.force[f]}
     also = {"lever3": {(f, "status") for f in spec.fingers} | {("lever_1", "moving"), ("grip", "push")},
-            "quad_bore": {("f_py", "status"), ("f_py", "noise"), ("f_py", "moving")}}.get(key, set())
+            }.get(key, set())
     assert off and off <= _fails(report) <= off | also, proc.stdout[-3000:]
+
+
+def test_twin_check_passes_four_independent_fingers_opening_into_a_bore(tmp_path):
+    # (each of four independent 25 N fingers presses its effort into the bore: the lift that carries them moves
+    # across their closing direction, so it is no spring in series with them)
+    proc, report = twin_check(GRIPPERS / SPECS["quad_bore"].station, tmp_path)
+    assert proc.returncode == 0 and not _fails(report), proc.stdout[-3000:]
 
 
 def test_twin_check_passes_the_cylinder_lying_still_on_its_table(tmp_path):

@@ -200,11 +200,6 @@ class Gripper:
         self._derive_drives(stiffness_given)
         self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
         self.effort_notes = self._defaulted_limits(mechanism) + self._unreachable_efforts()
-        # how many springy drives move each drive's fingers in series (a fine axis and the carriage it rides on: 2;
-        # a drive stiffer than the step resolves holds its command rigidly, and is no spring in the chain)
-        springy = {name for name, d in self.drives.items() if d.stiffness <= d.limit}
-        self._series = {name: max((len(springy.intersection(self.finger_servos[f])) for f in fs), default=1)
-                        if name in springy else 1 for name, fs in self._fingers_of_servo.items()}
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
         self.grip_force = {f: spec.grip_force if spec.grip_force is not None
@@ -230,6 +225,12 @@ class Gripper:
             client.resetJointState(body, joint, mult * self.setpoint[master] + off)
         self.closing = self._closing_directions()
         self._series_loads = self._series_couplings()
+        # how many springy drives move each drive's fingers in series along its motion (a fine axis and the carriage it
+        # rides on: 2; a lift across the closing direction is no spring in that chain;
+        # a drive stiffer than the step resolves holds its command rigidly, and is no spring in the chain)
+        springy = {name for name, d in self.drives.items() if d.stiffness <= d.limit}
+        self._series = {name: 1 + sum(1 for other, _ in self._series_loads.get(name, ()) if other in springy)
+                        if name in springy else 1 for name in self.names}
         self._series_holders = {s for ss in self._series_loads.values() for s, _ in ss}  # drives others press through
         self._series_share = {p: dict(ss) for p, ss in self._series_loads.items()}
         self._holding: set[str] = set()  # series drives holding their goals rigidly against one pressing through them
