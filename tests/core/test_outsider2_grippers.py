@@ -802,10 +802,6 @@ def test_twin_check_lifts_with_the_arm(name, tmp_path):
 
 # ---- a newcomer's geometry mistake -------------------------------------------------------------------------------
 
-@pytest.mark.xfail(strict=True, reason="the levers' tips start 10 mm inside the table (mount 20 mm lower than "
-                   "o2_pivot_2f_box's): loaded without a word (a target overlapping the gripper is an error, a fixture "
-                   "is not), the table throws the gripper up: lift.actual 10 mm at setpoint 0 with its drive at its "
-                   "full -30 N, and twin check PASSes (13 pass)")
 def test_a_gripper_starting_inside_a_fixture_is_refused_or_warned_about(tmp_path):
     station = tmp_path / "sunk"
     station.mkdir()

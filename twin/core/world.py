@@ -422,9 +422,19 @@ class World:
 
     def check_overlaps(self, tolerance: float = OVERLAP_TOLERANCE) -> None:
         """StationError when a target starts inside the gripper, the arm, a fixture or another target: physics
-        would shove it away (and fingers embedded in a part would grip it from step 0). Names both bodies."""
+        would shove it away (and fingers embedded in a part would grip it from step 0); or when the gripper starts
+        inside a fixture: the fixture would throw its links, against their drives, from step 0. Names both bodies."""
         c, st = self.client, self.station
         names = {uid: name for name, uid in self.body_ids.items()}
+        for i, fixture in enumerate(st.fixtures):
+            points = [pt for pt in c.getClosestPoints(self.machine, self.body_ids[fixture.name], 0.0)
+                      if not self.link_name.get(pt[3], "").startswith(ROBOT_PREFIX)]  # (the arm stands where it stands)
+            deepest = min(points, key=lambda pt: pt[8], default=None)
+            if deepest is not None and deepest[8] < -tolerance:
+                raise StationError(str(st.file), f"fixtures[{i}]", f"the gripper's link "
+                                   f"{self.link_name.get(deepest[3], 'base')!r} overlaps fixture {fixture.name!r} by "
+                                   f"{-deepest[8] * 1000:.1f} mm at the start (at {_mm(deepest[5])} mm): move the "
+                                   "fixture, the gripper's mount or its initial setpoints")
         done: set[frozenset] = set()
         for i, target in enumerate(st.targets):
             uid = self.body_ids[target.name]
