@@ -5,6 +5,8 @@ holds what friction can carry and drops what it cannot; actuals stay in their jo
 fit a link's mass and size are replaced, with one warning naming the link."""
 import logging
 import math
+import shutil
+import xml.etree.ElementTree as ET
 
 import pytest
 
@@ -323,3 +325,27 @@ def test_a_pressing_drive_builds_its_force_within_the_force_rise_time(tmp_path, 
         full = next(k for k, f in enumerate(forces, 1) if f >= 0.9 * 40.0) * twin.dt  # s after the touching step
         assert full <= rise + 2 * twin.dt
         assert full >= 0.5 * rise  # no faster than it says either
+
+
+def test_a_link_without_an_inertial_block_is_one_warning_saying_so(caplog, tmp_path):
+    # URDF leaves <inertial> optional; pybullet then makes the link 1 kg, which the warning must say is not the URDF's
+    from tests.grippers import station as gripper_folder
+    from twin.core import world
+
+    src = gripper_folder("newcomer_2f")
+    urdf = ET.parse(src / "newcomer_2f.urdf")
+    finger = next(link for link in urdf.getroot().iter("link") if link.find("collision") is not None
+                  and link.find("inertial") is not None and link.get("name") != urdf.getroot().find("link").get("name"))
+    finger.remove(finger.find("inertial"))
+    folder = tmp_path / "bare"
+    shutil.copytree(src, folder)
+    urdf.write(folder / "newcomer_2f.urdf")
+    (folder / "station.toml").write_text((src / "station.toml").read_text().replace(
+        '"../../../stations/', f'"{(src / "../../../stations").resolve().as_posix()}/'))
+    world._warned.clear()
+    with caplog.at_level(logging.WARNING, logger="twin"):
+        twin = Twin.from_station(folder)
+    with twin:
+        lines = [r.getMessage() for r in caplog.records if f"link {finger.get('name')}" in r.getMessage()]
+        assert len(lines) == 1 and "has no <inertial>" in lines[0] and "1 kg" in lines[0], lines
+        assert twin.world.client.getDynamicsInfo(twin.world.machine, twin.world.link_index[finger.get("name")])[0] == 1.0

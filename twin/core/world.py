@@ -220,11 +220,13 @@ INERTIA_SLACK = 10.0  # a link's inertia more than this many times that of the s
 _warned: set[tuple[str, str]] = set()  # (URDF, link): each warned of once per process
 
 
-def fix_inertias(c, body: int, link_name: dict[int, str], source: str) -> list[str]:
+def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inertial: frozenset = frozenset()
+                 ) -> list[str]:
     """Replace the inertia of every gripper link whose URDF inertia does not fit its mass and collision shapes by
     that of the solid box around those shapes (about its centre of mass, in its inertial frame; a mesh by the box
     around its link); one warning line per link, naming it. A link with no collision shape keeps what the URDF
-    says. Returns the warnings."""
+    says. `no_inertial`: the gripper links whose URDF has no <inertial> at all (pybullet makes them 1 kg): their
+    warning says so. Returns the warnings."""
     notes = []
     for link, name in sorted(link_name.items()):
         if name.startswith(ROBOT_PREFIX):
@@ -259,12 +261,19 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str) -> list[s
             box = [mass / 12 * (size[(i + 1) % 3] ** 2 + size[(i + 2) % 3] ** 2)
                    + mass * (mid[(i + 1) % 3] ** 2 + mid[(i + 2) % 3] ** 2) for i in range(3)]
             fits = all(b > 0 and b / INERTIA_SLACK ** 2 <= g <= b * INERTIA_SLACK for g, b in zip(given, box))
-            if fits:
+            if fits and name not in no_inertial:
                 continue
-            c.changeDynamics(body, link, localInertiaDiagonal=box)
-            note = (f"{source}: link {name}: inertia {' '.join(f'{g:.3g}' for g in given)} kg m^2 does not fit its "
-                    f"{mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the solid "
-                    f"box around them)")
+            if not fits:
+                c.changeDynamics(body, link, localInertiaDiagonal=box)
+            if name in no_inertial:
+                note = (f"{source}: link {name} has no <inertial>: pybullet makes it {mass:g} kg"
+                        + ("" if fits else f", with an inertia of {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
+                                           f"solid box around its collision shapes at that mass)")
+                        + ": give the link's real mass and inertia")
+            else:
+                note = (f"{source}: link {name}: inertia {' '.join(f'{g:.3g}' for g in given)} kg m^2 does not fit "
+                        f"its {mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
+                        f"solid box around them)")
             notes.append(note)
             if (source, name) not in _warned:
                 _warned.add((source, name))
@@ -373,7 +382,9 @@ class World:
             self.joint_index[info[1].decode()] = j
             self.link_index[info[12].decode()] = j
         self.link_name = {j: name for name, j in self.link_index.items()}
-        self.inertia_notes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf))
+        bare = frozenset(link.get("name", "") for link in _read(station.gripper.urdf, station.file, "gripper.urdf")
+                         .iter("link") if link.find("inertial") is None)  # (pybullet makes such a link 1 kg)
+        self.inertia_notes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf), bare)
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
 
