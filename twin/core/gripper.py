@@ -94,6 +94,14 @@ LOST_WATCH_STEPS = 25  # a gripped part no finger presses on any more, and that 
 RELEASE_SHARE = 0.25  # a grip lasts while every finger presses with this share of grip_force (no flicker)
 CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
 _warned_efforts: set[str] = set()  # each unreachable or defaulted limit warned of once per process
+
+
+def _warn_once(notes: list[str], note: str) -> None:
+    """Add `note` to `notes`, and log it as a warning the first time this process meets it."""
+    notes.append(note)
+    if note not in _warned_efforts:
+        _warned_efforts.add(note)
+        logging.getLogger("twin").warning("warning: %s", note)
 STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
 
 
@@ -384,13 +392,9 @@ class Gripper:
                     ("effort", inp.effort, o and o.effort, d.effort, "N" if inp.unit == "m" else "N m")):
                 if urdf or given:
                     continue
-                note = (f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing or 0): "
-                        f"its drive runs with {value:g} {unit}; give the real one in the URDF's <limit {what}=...> or in "
-                        f"[gripper.joints.{inp.name}] {what}")
-                notes.append(note)
-                if note not in _warned_efforts:
-                    _warned_efforts.add(note)
-                    logging.getLogger("twin").warning("warning: %s", note)
+                _warn_once(notes, f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing "
+                                  f"or 0): its drive runs with {value:g} {unit}; give the real one in the URDF's <limit "
+                                  f"{what}=...> or in [gripper.joints.{inp.name}] {what}")
         return notes
 
     def _unreachable_efforts(self) -> list[str]:
@@ -405,15 +409,12 @@ class Gripper:
                 continue
             m = self.unit[name] == "m"
             u, k = ("N", "N/m") if m else ("N m", "N m/rad")
-            note = (f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest position "
-                    f"loop the {self.h * 1000:g} ms substep keeps stable for what it moves ({d.stiffness:.4g} {k}) needs "
-                    f"{d.full_error:.3g} {self.unit[name]} of following error for it, more than the joint's range "
-                    f"({hi - lo:.3g} {self.unit[name]}): a finger presses with at most {d.stiffness * (hi - lo):.3g} {u}. "
-                    f"A placeholder? Give the drive's real effort in [gripper.joints.{name}] effort")
-            notes.append(note)
-            if note not in _warned_efforts:
-                _warned_efforts.add(note)
-                logging.getLogger("twin").warning("warning: %s", note)
+            _warn_once(notes, f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest "
+                              f"position loop the {self.h * 1000:g} ms substep keeps stable for what it moves "
+                              f"({d.stiffness:.4g} {k}) needs {d.full_error:.3g} {self.unit[name]} of following error for "
+                              f"it, more than the joint's range ({hi - lo:.3g} {self.unit[name]}): a finger presses with "
+                              f"at most {d.stiffness * (hi - lo):.3g} {u}. A placeholder? Give the drive's real effort in "
+                              f"[gripper.joints.{name}] effort")
         return notes
 
     def _inertia_about_axis(self, name: str, links, finger_links: set[int]) -> tuple[float, float]:
