@@ -917,7 +917,7 @@ class Gripper:
         c = self.client
         if self.palm_link == -1:
             return c.getBasePositionAndOrientation(self.body)
-        return c.getLinkState(self.body, self.palm_link, computeForwardKinematics=True)[:2]  # (its centre of mass frame, now)
+        return c.getLinkState(self.body, self.palm_link)[:2]  # (its centre of mass frame as the last physics substep left it)
 
     def _relative_pose(self, name: str):
         c = self.client
