@@ -207,6 +207,7 @@ class Gripper:
         self._pressing_none = {name: False for name in self.names}  # (read only: no drive's finger presses)
         self._derive_drives(stiffness_given)
         self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
+        self._constants: list[tuple] | None = None  # what `drive` asks of each drive at every substep, formed once
         self.effort_notes = self._defaulted_limits(mechanism) + self._unreachable_efforts()
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
@@ -315,6 +316,7 @@ class Gripper:
         self.drives[name] = Drive(d.velocity if velocity is None else float(velocity),
                                   d.effort if effort is None else float(effort), d.stiffness, d.damping, d.mass,
                                   d.limit, d.own)
+        self._constants = None  # (formed anew at the next substep)
 
     def set_active(self, active: bool) -> None:
         """Store the `Active` input; an always-active gripper keeps what was written but ignores it."""
@@ -585,54 +587,57 @@ class Gripper:
         loads, holders = self._series_loads, self._series_holders
         holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
         index, series_share = self._index, self._series_share
-        for (name, _, moving), (actual, joint_speed, _, _), moved in zip(self._per_input, states, self._speeds):
-            d = drives[name]
+        constants = self._constants
+        if constants is None:
+            constants = self._constants = self._drive_constants()
+        for (name, _, moving), (actual, joint_speed, _, _), moved, (
+                d, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads, in_holders,
+                in_series, own_share) in zip(self._per_input, states, self._speeds, constants):
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
-            full = d.full
             if before == g and not pressing and name not in turned and stalled.get(name) is None:
                 # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the ramp
                 # below gives, in short: the goal itself, within full force of the joint unless others press through it
                 way = None
-                target = g if name in holders else min(max(g, actual - full), actual + full)
+                target = g if in_holders else min(max(g, actual - full), actual + full)
             else:
                 # held: the joint moved slower than HELD_SHARE of its velocity limit the way its goal lies (last
                 # substep)
-                held = (moved if g > actual else -moved) < HELD_SHARE * d.velocity
+                held = (moved if g > actual else -moved) < held_speed
                 if name in turned:
                     turned.discard(name)
                     if (g - actual) * (before - actual) < 0.0:
                         before = actual  # a new goal the other way: the drive turns at once, from where the joint is
                         stalled[name] = None
                 way = stalled.get(name)
-                if way is not None and (g - before) * way > 0.0 and (before - actual) * way > RELEASE_FRACTION * full:
+                if way is not None and (g - before) * way > 0.0 and (before - actual) * way > release:
                     # stalled on a part: the command waits, so the finger holds where the part stopped it
                     target = before
-                    if (target - actual) * way < full * FOLLOW_FRACTION:
+                    if (target - actual) * way < follow:
                         # the part gave way: followed, pressing as stalled
-                        target = actual + way * full * LATCH_FRACTION
+                        target = actual + way * latch
                         if (g - target) * way < 0.0:
                             target = g
                 else:
                     way = None
-                    rate = d.velocity
+                    rate = velocity
                     if (before - actual) * (g - actual) > 0.0 and pressing and held:
                         # pressing on a part that holds the finger: full force within the rise time (a part that
                         # gives way is pushed at the velocity limit, as a real servo's speed loop does, not run over by
                         # the command)
-                        rate = max(rate, full / self.rise_time)
+                        rate = max(rate, rise_rate)
                     target = _towards(before, g, rate * h)
                 # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
                 # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
                 # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
-                if target != g or name not in holders:
+                if target != g or not in_holders:
                     target = min(max(target, actual - full), actual + full)
-                if (target != g and abs(target - actual) >= full * LATCH_FRACTION
+                if (target != g and abs(target - actual) >= latch
                         and (g - actual) * (target - actual) > 0.0 and pressing):
                     if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on
                         # past it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
-                        target = actual + (1.0 if target > actual else -1.0) * full * LATCH_FRACTION
+                        target = actual + (1.0 if target > actual else -1.0) * latch
                     # held short of its goal by a part, at its force limit: stalled
                     way = 1.0 if target > actual else -1.0
             stalled[name] = way
@@ -642,10 +647,10 @@ class Gripper:
             speed = error / h  # to be at the command after the substep, as far as the force allows
             rigid = d.rigid  # stiffer than the step resolves (a station's choice): rigid up to its effort
             leaning = False
-            if pressing and name in loads:
+            if pressing and in_loads:
                 if target != g:  # pressing through drives in series: leaning on those that stand at their goals
                     leaning = any(command[other] == goal[other] for other, _ in loads[name])
-                elif not rigid and name in holders:
+                elif not rigid and in_holders:
                     for other, _ in loads[name]:
                         if command[other] == goal[other]:
                             continue
@@ -666,23 +671,22 @@ class Gripper:
                             rigid = True
                             now_holding.add(name)
                             break
-            if series[name] > 1 and pressing and not rigid and not any(o in holding for o, _ in loads.get(name, ())):
+            if in_series and pressing and not rigid and not any(o in holding for o, _ in loads[name]):
                 # drives in series on one pressed finger (a fine axis on its carriage): the part holds their sum, and
                 # what moves between them is their own links alone, not the part: each taking its whole error out
                 # in one substep throws the pair against each other (every substep, the part standing); each takes
                 # out the share of it that its own links bear to the mass its gains were derived for (leaning on
                 # one that holds rigidly, it presses alone, as on a fine axis stiffer than the step resolves)
-                speed *= d.own / d.mass
-            if abs(error) >= full * (1.0 - 1e-9) and toward <= 0.0:
+                speed *= own_share
+            if abs(error) >= at_limit and toward <= 0.0:
                 # at its force limit and held (or pushed) back: pybullet's solver builds a motor's force only as fast
                 # as the speed it asks for, so a held drive asks for far more than it can have: it presses at its limit
-                speed = max(abs(speed), PUSH_SPEEDUP * d.velocity) * (1.0 if error > 0.0 else -1.0)
-            elif abs(speed) > d.velocity and moved * error >= HELD_SHARE * d.velocity * abs(error):
+                speed = max(abs(speed), PUSH_SPEEDUP * velocity) * (1.0 if error > 0.0 else -1.0)
+            elif abs(speed) > velocity and moved * error >= held_speed * abs(error):
                 # running free (a part that gives way, a finger catching up): never faster than the velocity limit;
                 # a held joint asks for more (the solver builds the force against the part from that speed)
-                speed = d.velocity if speed > 0.0 else -d.velocity
+                speed = velocity if speed > 0.0 else -velocity
             velocities.append(speed)
-            effort = d.effort
             if leaning:
                 # pressing through drives in series that stand at their goals (a carriage through its fine axis):
                 # never harder than they hold, less a reserve, or the one that holds is pushed off its goal at its
@@ -705,6 +709,21 @@ class Gripper:
             self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
                          forces=forces)
             self._sent = sent
+
+    def _drive_constants(self) -> list[tuple]:
+        """Per input (`names` order), what `drive` asks of its drive at every substep, formed once (again after
+        `set_limits`): the drive, its full-force error, velocity, effort, the speed under which it is held, the force
+        rise's rate, its release, latch and follow errors, the error at its limit, whether it presses through drives
+        in series (and which hold others), whether it has springs in series, its own links' share of its mass."""
+        out = []
+        for name in self.names:
+            d = self.drives[name]
+            full = d.full
+            out.append((d, full, d.velocity, d.effort, HELD_SHARE * d.velocity, full / self.rise_time,
+                        RELEASE_FRACTION * full, full * LATCH_FRACTION, full * FOLLOW_FRACTION, full * (1.0 - 1e-9),
+                        name in self._series_loads, name in self._series_holders, self._series[name] > 1,
+                        d.own / d.mass if d.mass else 0.0))
+        return out
 
     def read_along(self, joints: list[int]) -> None:
         """Read `joints` (of the same body) with the inputs' joints after each step's last substep, into `along`
