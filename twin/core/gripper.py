@@ -177,10 +177,13 @@ class Gripper:
         self._range = {inp.name: (inp.min, inp.max) for inp in mechanism.inputs}
         self.drives: dict[str, Drive] = {}
         stiffness_given: dict[str, float | None] = {}
+        defaulted = []  # (input, "velocity" or "effort"): neither the station nor the URDF gives it
         for inp in mechanism.inputs:
             o = spec.joints.get(inp.name)
-            velocity = (o.velocity if o and o.velocity else None) or inp.velocity or DEFAULT_VELOCITY[inp.unit]
-            effort = (o.effort if o and o.effort else None) or inp.effort or DEFAULT_EFFORT[inp.unit]
+            velocity = (o.velocity if o and o.velocity else None) or inp.velocity
+            effort = (o.effort if o and o.effort else None) or inp.effort
+            defaulted += [(inp, what) for what, value in (("velocity", velocity), ("effort", effort)) if not value]
+            velocity, effort = velocity or DEFAULT_VELOCITY[inp.unit], effort or DEFAULT_EFFORT[inp.unit]
             stiffness_given[inp.name] = o.stiffness if o and o.stiffness else None
             self.drives[inp.name] = Drive(velocity, effort, stiffness_given[inp.name] or effort / FULL_FORCE_ERROR[inp.unit])
         master_input = {inp.joint: inp.name for inp in mechanism.inputs}
@@ -208,7 +211,7 @@ class Gripper:
         self._derive_drives(stiffness_given)
         self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
         self._constants: list[tuple] | None = None  # what `drive` asks of each drive at every substep, formed once
-        self.effort_notes = self._defaulted_limits(mechanism) + self._unreachable_efforts()
+        self.effort_notes = self._defaulted_limits(defaulted) + self._unreachable_efforts()
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
         self.grip_force = {f: spec.grip_force if spec.grip_force is not None
@@ -381,22 +384,17 @@ class Gripper:
             self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * own / (share * h), mass, limit,
                                       own)
 
-    def _defaulted_limits(self, mechanism: Mechanism) -> list[str]:
+    def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[str]:
         """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,
-        as exporters leave them) nor the station gives: the default the drive runs with, and where to give the real
-        one."""
+        as exporters leave them) nor the station gives (`defaulted`: (input, "velocity" or "effort")): the default the
+        drive runs with, and where to give the real one."""
         notes = []
-        for inp in mechanism.inputs:
-            o = self.spec.joints.get(inp.name)
-            d = self.drives[inp.name]
-            for what, urdf, given, value, unit in (
-                    ("velocity", inp.velocity, o and o.velocity, d.velocity, "m/s" if inp.unit == "m" else "rad/s"),
-                    ("effort", inp.effort, o and o.effort, d.effort, "N" if inp.unit == "m" else "N m")):
-                if urdf or given:
-                    continue
-                _warn_once(notes, f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing "
-                                  f"or 0): its drive runs with {value:g} {unit}; give the real one in the URDF's <limit "
-                                  f"{what}=...> or in [gripper.joints.{inp.name}] {what}")
+        for inp, what in defaulted:
+            value = getattr(self.drives[inp.name], what)
+            unit = f"{inp.unit}/s" if what == "velocity" else "N" if inp.unit == "m" else "N m"
+            _warn_once(notes, f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing or "
+                              f"0): its drive runs with {value:g} {unit}; give the real one in the URDF's <limit "
+                              f"{what}=...> or in [gripper.joints.{inp.name}] {what}")
         return notes
 
     def _unreachable_efforts(self) -> list[str]:

@@ -157,9 +157,9 @@ class Twin:
                     gripper.measure(k == substeps - 1)
             self.step_count += 1
             self.gripper.sense()
-            if world.rolling:  # (round parts in the cell)
-                world.free_rolling(gripper.touched_bodies())
             self._publish(gripper.along)
+            if world.rolling:  # (round parts in the cell: the targets' poses as the snapshot read them)
+                world.free_rolling(gripper.touched_bodies(), dict(zip(self._target_ids, self._read[3])))
             world.stasis.after_step(self._machine_still)
             for device in self.devices:
                 device.after_step(self)

@@ -143,19 +143,19 @@ def _gripper_for_pybullet(gripper_urdf: Path, file: Path, out_dir: Path | None =
     return gripper
 
 
-def write_gripper(gripper_urdf: Path, file: Path, out_dir: Path) -> Path:
-    """The gripper's URDF as the world loads it when there is no robot."""
+def write_gripper(gripper: ET.Element, out_dir: Path) -> Path:
+    """The gripper's URDF (`_gripper_for_pybullet`'s) as the world loads it when there is no robot."""
     out = out_dir / "gripper.urdf"
-    ET.ElementTree(_gripper_for_pybullet(gripper_urdf, file, out_dir)).write(out)
+    ET.ElementTree(gripper).write(out)
     return out
 
 
-def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper_urdf: Path, gripper_root: str,
+def merge_gripper_into_robot(robot_urdf: Path, flange_link: str, gripper: ET.Element, gripper_root: str,
                              mount: Placement, out_dir: Path, file: Path) -> Path:
-    """Write one URDF where the gripper's root link hangs off the robot's flange by a fixed joint."""
+    """Write one URDF where the gripper's root link (`gripper`: `_gripper_for_pybullet`'s URDF) hangs off the
+    robot's flange by a fixed joint."""
     robot = _read(robot_urdf, file, "robot.urdf")
     _absolutize_meshes(robot, robot_urdf, file, "robot.urdf")
-    gripper = _gripper_for_pybullet(gripper_urdf, file, out_dir)
     for elem in robot:
         if elem.tag in ("link", "joint"):
             elem.set("name", ROBOT_PREFIX + elem.get("name", ""))
@@ -341,17 +341,18 @@ class World:
         self.rolling = {self.body_ids[b.name]: 0.0 for b in station.targets if b.dynamic and b.shape == "cylinder"}
         g = math.sqrt(sum(v * v for v in station.gravity))
         self._down = tuple(v / g for v in station.gravity) if g else (0.0, 0.0, -1.0)
-        self.free_rolling(set())
+        self.free_rolling(set(), {uid: self.client.getBasePositionAndOrientation(uid) for uid in self.rolling})
 
-    def free_rolling(self, touched: set[int]) -> None:
+    def free_rolling(self, touched: set[int], poses: dict) -> None:
         """Loose cylinders lying on their side that no finger touches resist rolling (ROLLING_RESISTANCE): one lying
         still stays where it lies. Standing on an end, or between fingers (`touched`, body ids), they have no rolling
-        friction: nothing for it to do there but change how a squeezed part settles. Applied from the next step."""
-        pose_of, (dx, dy, dz) = self.client.getBasePositionAndOrientation, self._down
+        friction: nothing for it to do there but change how a squeezed part settles. `poses`: body id -> (position,
+        orientation), as the step read them. Applied from the next step."""
+        dx, dy, dz = self._down
         for uid, now in self.rolling.items():
             want = 0.0
             if uid not in touched:
-                x, y, z, w = pose_of(uid)[1]  # the cylinder's axis (its local z) in the world, against the vertical
+                x, y, z, w = poses[uid][1]  # the cylinder's axis (its local z) in the world, against the vertical
                 if abs(2 * (x * z + w * y) * dx + 2 * (y * z - w * x) * dy + (1 - 2 * (x * x + y * y)) * dz) < LYING:
                     want = ROLLING_RESISTANCE
             if want != now:
@@ -364,12 +365,15 @@ class World:
         for fixture in station.fixtures:
             self.body_ids[fixture.name] = self._create_body(fixture)
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+        gripper = _gripper_for_pybullet(station.gripper.urdf, station.file, Path(self._tmp.name))
+        bare = frozenset(link.get("name", "") for link in gripper.iter("link")
+                         if link.find("inertial") is None)  # (pybullet makes such a link 1 kg)
         if station.robot is not None:
-            urdf = merge_gripper_into_robot(station.robot.urdf, station.robot.flange_link, station.gripper.urdf,
-                                            gripper_root, station.gripper.mount, Path(self._tmp.name), station.file)
+            urdf = merge_gripper_into_robot(station.robot.urdf, station.robot.flange_link, gripper, gripper_root,
+                                            station.gripper.mount, Path(self._tmp.name), station.file)
             base, key, source = station.robot.base, "robot.urdf", f"{station.robot.urdf} with the gripper"
         else:
-            urdf = write_gripper(station.gripper.urdf, station.file, Path(self._tmp.name))
+            urdf = write_gripper(gripper, Path(self._tmp.name))
             base, key, source = station.gripper.mount, "gripper.urdf", str(station.gripper.urdf)
         try:
             self.machine = self.client.loadURDF(str(urdf), base.xyz, quat(base), useFixedBase=True, flags=flags)
@@ -382,8 +386,6 @@ class World:
             self.joint_index[info[1].decode()] = j
             self.link_index[info[12].decode()] = j
         self.link_name = {j: name for name, j in self.link_index.items()}
-        bare = frozenset(link.get("name", "") for link in _read(station.gripper.urdf, station.file, "gripper.urdf")
-                         .iter("link") if link.find("inertial") is None)  # (pybullet makes such a link 1 kg)
         self.inertia_notes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf), bare)
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
