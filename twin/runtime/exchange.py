@@ -111,7 +111,10 @@ class Exchange:
 
     def check(self, name: str, value):
         """A write's value, normalised, or the error every front end reports (see the module docstring)."""
-        spec = self.spec(name)
+        try:
+            spec = self._spec[name]
+        except KeyError:
+            raise SignalError(name, "no such signal") from None
         value = spec.check(value)
         if name == SIM_ADVANCE:
             runner = self.runner
@@ -127,9 +130,15 @@ class Exchange:
         Returns the batch as queued (values normalised). On any error nothing is queued."""
         if self.fault:
             raise SimulationFault(self.twin.step_count)
-        batch = [(name, self.check(name, value)) for name, value in writes]
-        advance = sum(int(v) for n, v in batch if n == SIM_ADVANCE)
-        signals = [(n, v) for n, v in batch if n not in SIM_NAMES]
+        check = self.check
+        batch, signals, advance = [], [], 0
+        for name, value in writes:
+            value = check(name, value)
+            batch.append((name, value))
+            if name not in SIM_NAMES:
+                signals.append((name, value))
+            elif name == SIM_ADVANCE:
+                advance += int(value)
         if signals:
             self.pending.append(signals)
             self._written.update(signals)

@@ -7,14 +7,20 @@ becomes one batch of (signal, SI value) for `exchange.submit`: it is validated t
 write (an error answers exception 03, a faulted simulation 04) and takes effect at the next step.
 
 Inputs (coils, holding registers) are what a client wrote: an accepted write (from this or any other
-front end) is copied into their images at once (`_show_written`), so reading it back gives the written
-value before the step applies it. A publish lays the writes still queued over the snapshot, so no step
-can undo that.
+front end) shows in their images at once, so reading it back gives the written value before the step
+applies it; the images are always the last snapshot with the writes still queued laid over it, so no
+step can undo that.
+
+The images are formed when a request reads them, not at every step: a publish only notes the snapshot,
+an accepted write only that the images must be formed anew. So a lockstep client that asks for several
+steps pays for one encoding, and a write followed by its step (a PLC's scan) for none of its own. Only the
+values that changed since the last encoding are encoded (most do not from one step to the next).
 """
 from __future__ import annotations
 
 from collections.abc import Sequence
-from operator import itemgetter
+from itertools import compress
+from operator import is_not, itemgetter
 
 from twin.core.errors import SignalError, TwinError
 from twin.runtime.exchange import Exchange, SimulationFault, Snapshot
@@ -35,25 +41,30 @@ class TwinBridge:
         self._advance = rmap[ADVANCE] if ADVANCE in rmap else None
         self.live_addresses = frozenset({self._advance.address} if self._advance is not None else ())
         self.crc = rmap.crc  # sim.map_crc: the CRC of the map this front end serves
-        # the images as of the last snapshot, kept between publishes: a publish re-encodes only the values that
-        # changed (most do not from one step to the next) into them
+        # the images as of the last snapshot encoded, kept between encodings: only the values that changed are
+        # encoded into them
         self._buffers = {t: bytearray(size if t in BIT_TABLES else 2 * size) for t, size in self._sizes.items()}
-        self._last = {t: (_UNSET,) * len(entries) for t, entries in self._keyed.items()}
-        self._bytes = {t: bytes(b) for t, b in self._buffers.items()}  # each image as last built from its buffer
-        # per table: its values taken from a snapshot in one call, and how each is written into the image
         values = exchange.snapshot.values
-        self._tables = []
+        self._tables = []  # per table: its values taken from a snapshot in one call, and how each is encoded
         for t, entries in self._keyed.items():
+            if t not in BIT_TABLES:  # sim.map_crc is this map's CRC whatever the snapshot says: encoded once
+                for e, key in entries:
+                    if key == MAP_CRC:
+                        e.pack_into(self._buffers[t], 2 * e.address, self.crc)
+                entries = [(e, key) for e, key in entries if key != MAP_CRC]
             keys = tuple(key for _, key in entries)
             take = (_taker(keys) if all(k in values for k in keys)
                     else (lambda v, keys=keys: tuple(v.get(k, 0) for k in keys)))
-            crc_at = keys.index(MAP_CRC) if MAP_CRC in keys and t not in BIT_TABLES else None
             if t in BIT_TABLES:
                 writers = tuple(e.address for e, _ in entries)
             else:
                 writers = tuple((e._packer.pack_into, 2 * e.address, e.counter) for e, _ in entries)
-            self._tables.append((t, take, crc_at, t in BIT_TABLES, writers))
-        self.images: Images = Images(b"", b"", b"", b"")
+            self._tables.append((t, take, t in BIT_TABLES, writers, range(len(keys))))
+        self._last = {t: (_UNSET,) * len(writers) for t, _, _, writers, _ in self._tables}
+        self._encoded: Images = Images(*(bytes(self._buffers[t]) for t in (COIL, DISCRETE_INPUT, HOLDING_REGISTER,
+                                                                          INPUT_REGISTER)))
+        self._snapshot: Snapshot | None = None  # published, not yet encoded
+        self._images: Images | None = None  # None: formed anew at the next read
         self.publish(exchange.snapshot)
         self._unsubscribe = exchange.subscribe(on_snapshot=self.publish, on_writes=self._show_written)
 
@@ -109,8 +120,32 @@ class TwinBridge:
         return None
 
     # -- the exchange's side --------------------------------------------------------------------------
+    @property
+    def images(self) -> Images:
+        """The four tables: the last snapshot, with the writes still queued laid over it (formed at the first read
+        after a step or a write, see the module docstring)."""
+        images = self._images
+        if images is None:
+            if self._snapshot is not None:
+                self._encode(self._snapshot.values)
+                self._snapshot = None
+            images = self._encoded
+            for batch in self.exchange.pending:  # written but not yet applied (none after a step): read as written
+                images = self._written_over(images, batch)
+            self._images = images
+        return images
+
+    def publish(self, snapshot: Snapshot | None = None) -> None:
+        """A new snapshot (default: the exchange's latest): the images are formed from it when next read."""
+        self._snapshot = snapshot or self.exchange.snapshot
+        self._images = None
+
     def _show_written(self, batch: Sequence[tuple[str, object]]) -> None:
-        """Copy accepted writes into the coil and holding-register images (as the next publish will show them)."""
+        """An accepted write (of any front end): the coil and holding-register images show it from the next read."""
+        self._images = None
+
+    def _written_over(self, images: Images, batch: Sequence[tuple[str, object]]) -> Images:
+        """`images` with a batch of writes in the coil and holding-register images."""
         coils = holding = None
         for name, value in batch:
             entry = self._by_signal.get(name)
@@ -118,26 +153,23 @@ class TwinBridge:
                 continue
             if entry.table == COIL:
                 if coils is None:
-                    coils = bytearray(self.images.coils)
+                    coils = bytearray(images.coils)
                 coils[entry.address] = 1 if value else 0
             elif entry.table == HOLDING_REGISTER:
                 if holding is None:
-                    holding = bytearray(self.images.holding)
+                    holding = bytearray(images.holding)
                 entry.pack_into(holding, 2 * entry.address, value)
-        if coils is not None or holding is not None:
-            old = self.images
-            self.images = Images(old.coils if coils is None else bytes(coils), old.discrete_inputs,
-                                 old.holding if holding is None else bytes(holding), old.input_registers)
+        if coils is None and holding is None:
+            return images
+        return Images(images.coils if coils is None else bytes(coils), images.discrete_inputs,
+                      images.holding if holding is None else bytes(holding), images.input_registers)
 
-    def publish(self, snapshot: Snapshot | None = None) -> None:
-        """New images from a snapshot (default: the exchange's latest), with the writes still queued on top.
-        Only the values that changed since the last snapshot are encoded (most do not from one step to the next)."""
-        values = (snapshot or self.exchange.snapshot).values
-        buffers, lasts, images = self._buffers, self._last, self._bytes
-        for table, take, crc_at, bits, writers in self._tables:
+    def _encode(self, values) -> None:
+        """The snapshot's values into `_encoded`: only the tables, and in them only the values, that changed."""
+        buffers, lasts = self._buffers, self._last
+        changed = {}
+        for table, take, bits, writers, indices in self._tables:
             new = take(values)
-            if crc_at is not None:
-                new = (*new[:crc_at], self.crc, *new[crc_at + 1:])
             last = lasts[table]
             if new == last:  # the same values: the image as it was
                 continue
@@ -146,16 +178,21 @@ class TwinBridge:
                 for address, v in zip(writers, new):
                     buf[address] = 1 if v else 0
             else:
-                for old, v, (pack_into, offset, counter) in zip(last, new, writers):
+                # the values that are not the very same objects (most of the rest are new floats)
+                for i in compress(indices, map(is_not, last, new)):
+                    old, v = last[i], new[i]
                     # equal values of the same type pack the same words (a changed type, e.g. 1 for 1.0, is packed)
-                    if old is v or (old == v and type(old) is type(v)):
+                    if old == v and type(old) is type(v):
                         continue
+                    pack_into, offset, counter = writers[i]
                     pack_into(buf, offset, counter(v))
             lasts[table] = new
-            images[table] = bytes(buf)
-        self.images = Images(images[COIL], images[DISCRETE_INPUT], images[HOLDING_REGISTER], images[INPUT_REGISTER])
-        for batch in self.exchange.pending:  # written but not yet applied (empty after a step): still reads as written
-            self._show_written(batch)
+            changed[table] = bytes(buf)
+        if changed:
+            old = self._encoded
+            self._encoded = Images(changed.get(COIL, old.coils), changed.get(DISCRETE_INPUT, old.discrete_inputs),
+                                   changed.get(HOLDING_REGISTER, old.holding),
+                                   changed.get(INPUT_REGISTER, old.input_registers))
 
 
 def _taker(keys: tuple[str, ...]):

@@ -31,6 +31,8 @@ WRITE_FUNCTIONS = frozenset({5, 6, 15, 16, 22, 23})
 MEI, MEI_DEVICE_ID = 0x2B, 0x0E
 
 _AQ = struct.Struct(">HH")
+_H = struct.Struct(">H")
+_RW = struct.Struct(">HHHH")  # function 23: read address and count, write address and count
 
 
 @dataclass(frozen=True)
@@ -220,6 +222,8 @@ class _Table:
 
 
 _ASCII_BITS = bytes.maketrans(b"\x00\x01", b"01")
+# what a write of an entry in the output window is (`PduHandler._window_plan`)
+_COIL, _COMMAND, _VALUE = "coil", "command", "value"
 
 
 @functools.lru_cache(maxsize=None)
@@ -228,13 +232,17 @@ def _words(n: int) -> struct.Struct:
     return struct.Struct(f">{n}H")
 
 
-def _patched(backend, holding: bytes) -> bytes:
-    """The holding-register image with its live registers (sim.advance) filled in."""
+def _patched(backend, holding: bytes, live: Sequence[tuple[int, int | None]] | None = None) -> bytes:
+    """The holding-register image with its live registers (sim.advance) filled in (`live`: (address, value) as
+    read already)."""
+    if live is None:
+        live = [(a, backend.live_holding(a)) for a in backend.live_addresses]
+    if all(v is None or 2 * a + 2 > len(holding) or holding[2 * a:2 * a + 2] == _H.pack(v) for a, v in live):
+        return holding  # they read as the image has them (sim.advance 0 once the steps are done)
     out = bytearray(holding)
-    for a in backend.live_addresses:
-        v = backend.live_holding(a)
+    for a, v in live:
         if v is not None and 2 * a + 2 <= len(out):
-            struct.pack_into(">H", out, 2 * a, v)
+            _H.pack_into(out, 2 * a, v)
     return bytes(out)
 
 
@@ -266,7 +274,7 @@ class PduHandler:
         self.tables = {t: _Table(rmap, t, gaps_zero) for t in TABLES}
         self.layout = ImageLayout({t: self.tables[t].size for t in TABLES})
         self._plans: dict[tuple[int, int], list] = {}  # (window start, words) -> the entries a write covers
-        self._in_cache: tuple[object, bytes] | None = None
+        self._in_cache: tuple | None = None  # (images, live registers, the input window as they make it)
         self._holding_cache: tuple | None = None  # (holding image, live words, the words as they read)
         self._in_parts: dict[str, tuple[bytes, bytes]] = {}  # table -> (its image, packed into the input window)
         self.identity = identity or DeviceIdentity()
@@ -278,6 +286,11 @@ class PduHandler:
         adv = rmap.by_name.get(ADVANCE)
         self._advance = adv if adv is not None and adv.table == HOLDING_REGISTER else None
         self._map_file: MapFile | None = None
+        # holding registers read live (sim.advance); a backend that serves no window may have none
+        self._live = tuple(sorted(getattr(backend, "live_addresses", ())))
+        # sim.advance's address in the output window
+        self._advance_out = (None if self._advance is None
+                             else IMAGE_OUT + self.layout.out_offset[HOLDING_REGISTER] + self._advance.address)
 
     def handle(self, pdu: bytes, hold: PollHold | None = None) -> bytes:
         """One request PDU -> its response PDU (an exception: the function code | 0x80 and the code).
@@ -385,10 +398,11 @@ class PduHandler:
 
     def _input_window(self) -> bytes:
         images = self.backend.images
-        live = [self.backend.live_holding(a) for a in sorted(self.backend.live_addresses)]
-        key = (images, tuple(live))
-        if self._in_cache is not None and self._in_cache[0] == key:
-            return self._in_cache[1]
+        live_holding = self.backend.live_holding
+        live = tuple([(a, live_holding(a)) for a in self._live])
+        cached = self._in_cache
+        if cached is not None and cached[0] is images and cached[1] == live:
+            return cached[2]
         lay = self.layout
         parts = self._in_parts  # each table's part as last packed, kept while its image stays the same object
         di = parts.get(DISCRETE_INPUT)
@@ -399,13 +413,15 @@ class PduHandler:
         if coils is None or coils[0] is not images.coils:
             coils = parts[COIL] = (images.coils,
                                    pack_words(images.coils, lay.in_offset[HOLDING_REGISTER] - lay.in_offset[COIL]))
-        window = di[1] + images.input_registers + coils[1] + _patched(self.backend, images.holding)
-        self._in_cache = (key, window)
+        window = b"".join((di[1], images.input_registers, coils[1], _patched(self.backend, images.holding, live)))
+        self._in_cache = (images, live, window)
         return window
 
     def _window_plan(self, start: int, end: int) -> list:
-        """The output window's words start..end as (offset, table, address, entry), in address order, with
-        (offset, None, code, None) where a write of them must stop with exception `code` (part of an entry)."""
+        """The output window's words start..end as (offset, table, address, entry, kind, writable), in address
+        order, with (offset, None, code, None, None, False) where a write of them must stop with exception `code`
+        (part of an entry). `kind`: `_COIL`, `_COMMAND` (a writable entry of the simulator's own, sim.advance) or
+        `_VALUE` (a holding register's value)."""
         lay = self.layout
         plan = []
         k = start
@@ -418,14 +434,15 @@ class PduHandler:
             e = t.entry_at.get(a)
             if e is None:
                 if t.valid[a]:  # inside an entry that starts before the write: only part of it
-                    plan.append((k - start, None, ILLEGAL_DATA_ADDRESS, None))
+                    plan.append((k - start, None, ILLEGAL_DATA_ADDRESS, None, None, False))
                     break
                 k += 1  # an unmapped address: ignored
                 continue
             if k + e.count > end:
-                plan.append((k - start, None, ILLEGAL_DATA_ADDRESS, None))
+                plan.append((k - start, None, ILLEGAL_DATA_ADDRESS, None, None, False))
                 break
-            plan.append((k - start, table, a, e))
+            kind = _COIL if table == COIL else _COMMAND if e.signal is None and e.writable else _VALUE
+            plan.append((k - start, table, a, e, kind, e.writable))
             k += e.count
         return plan
 
@@ -441,8 +458,9 @@ class PduHandler:
         self._holding_cache = (holding, live, words)
         return words
 
-    def _write_window(self, address: int, words: Sequence[int]) -> int:
-        """A write into the output window: the entries it covers, all or nothing (see ImageLayout)."""
+    def _write_window(self, address: int, words: Sequence[int], raw: bytes | None = None) -> int:
+        """A write into the output window: the entries it covers, all or nothing (see ImageLayout). `raw`: the
+        words as the request carried them (big-endian bytes), to compare with the image as it reads."""
         start = address - IMAGE_OUT
         if address < IMAGE_OUT or start + len(words) > self.layout.out_size:
             return ILLEGAL_DATA_ADDRESS
@@ -452,42 +470,45 @@ class PduHandler:
             plan = self._plans[key] = self._window_plan(start, start + len(words))
         changes = []
         images = self.backend.images
+        live = self._live
         current_h = None
-        for off, table, a, e in plan:
+        for off, table, a, e, kind, writable in plan:
             if table is None:
                 return a
-            count = e.count
-            chunk = tuple(words[off:off + count])
-            if table == COIL:
-                if chunk[0] not in (0, 1):
+            end = off + e.count
+            if kind is _COIL:
+                w = words[off]
+                if w != 0 and w != 1:
                     return ILLEGAL_DATA_VALUE
-                same = images.coils[a] == chunk[0]
-            elif e.signal is None and e.writable:  # a command (below): taken whatever it reads now
-                same = False
+                same = images.coils[a] == w
+            elif kind is _COMMAND:  # the simulator's own entries are commands (sim.advance: N more steps), taken
+                same = False        # whatever they read now
+            elif raw is not None and a not in live:
+                same = raw[2 * off:2 * end] == images.holding[2 * a:2 * (a + end - off)]
             else:
                 if current_h is None:
                     current_h = self._holding_words(images.holding)
-                same = current_h[a:a + count] == chunk
-            if not e.writable:
-                if not same:
-                    return ILLEGAL_DATA_ADDRESS
-            elif not same or e.signal is None:  # words written back as they read are no change (a PLC rewrites
-                # its whole image), but the simulator's own entries are commands (sim.advance: N more steps)
-                value = e.si_of_words(chunk)
-                if value is None:
-                    return ILLEGAL_DATA_VALUE
-                changes.append((e, value))
+                same = current_h[a:a + end - off] == tuple(words[off:end])
+            if same:  # words written back as they read are no change (a PLC writes its whole image every scan)
+                continue
+            if not writable:
+                return ILLEGAL_DATA_ADDRESS
+            value = e.si_of_words(words[off:end])
+            if value is None:
+                return ILLEGAL_DATA_VALUE
+            changes.append((e, value))
         return self.backend.submit(changes) if changes else 0
 
     # -- writes ---------------------------------------------------------------------------------------
-    def _write(self, table: str, address: int, words: Sequence[int], advances: bool | None = None) -> int:
+    def _write(self, table: str, address: int, words: Sequence[int], advances: bool | None = None,
+               raw: bytes | None = None) -> int:
         """Validate and queue a write of `words` (or bits) at `address`. 0 or an exception code. `advances`:
-        whether it sets sim.advance, when known (`_advances`)."""
+        whether it sets sim.advance, when known (`_advances`); `raw`: the registers' bytes as the request carried them."""
         if (self.hold is not None and table == HOLDING_REGISTER
                 and (self._advances(address, words) if advances is None else advances)):
             self.hold.release()  # the client asked for steps: its next read is of them
         if table == HOLDING_REGISTER and address >= IMAGE_OUT:
-            return self._write_window(address, words)
+            return self._write_window(address, words, raw)
         t = self.tables[table]
         if not t.writable(address, len(words)):
             return ILLEGAL_DATA_ADDRESS
@@ -536,7 +557,7 @@ class PduHandler:
         if not 1 <= count <= MAX_WRITE_REGISTERS or nbytes != 2 * count or len(pdu) != 6 + nbytes:
             return ILLEGAL_DATA_VALUE
         words = _words(count).unpack_from(pdu, 6)
-        return self._write(HOLDING_REGISTER, address, words) or pdu[:5]
+        return self._write(HOLDING_REGISTER, address, words, raw=pdu[6:]) or pdu[:5]
 
     def _mask_write_register(self, pdu: bytes):
         """6.16: result = (current AND and_mask) OR (or_mask AND NOT and_mask); the response echoes the request."""
@@ -553,7 +574,7 @@ class PduHandler:
     def _read_write_registers(self, pdu: bytes):
         if len(pdu) < 10:
             return ILLEGAL_DATA_VALUE
-        raddr, rcount, waddr, wcount = struct.unpack_from(">HHHH", pdu, 1)
+        raddr, rcount, waddr, wcount = _RW.unpack_from(pdu, 1)
         nbytes = pdu[9]
         if (not 1 <= rcount <= MAX_RW_READ or not 1 <= wcount <= MAX_RW_WRITE or nbytes != 2 * wcount
                 or len(pdu) != 10 + nbytes):
@@ -565,13 +586,13 @@ class PduHandler:
         # The spec's order: the write first, then the read (which sees the write).
         words = _words(wcount).unpack_from(pdu, 10)
         advances = self._advances(waddr, words)
-        code = self._write(HOLDING_REGISTER, waddr, words, advances)
+        code = self._write(HOLDING_REGISTER, waddr, words, advances, pdu[10:])
         if code:
             return code
 
         def read():
             data = self.registers(HOLDING_REGISTER, raddr, rcount)
-            return bytes((23, len(data))) + data
+            return b"".join((bytes((23, len(data))), data))
 
         if advances and self.backend.stepping():
             return Deferred(read)  # lockstep: the read sees the state after the steps asked for
@@ -582,7 +603,7 @@ class PduHandler:
         adv = self._advance
         if adv is None:
             return False
-        at = adv.address if address < IMAGE_OUT else IMAGE_OUT + self.layout.out_offset[HOLDING_REGISTER] + adv.address
+        at = adv.address if address < IMAGE_OUT else self._advance_out
         return address <= at < address + len(words) and words[at - address] != 0
 
     # -- 20: read file record (6.14): the register map ---------------------------------------------------
