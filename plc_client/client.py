@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import functools
 import math
+from itertools import compress
+from operator import itemgetter, ne
 import socket
 import ssl
 import struct
@@ -239,6 +241,7 @@ class TwinClient:
         self.heartbeats = 0
         self._tid = 0  # the transaction id of the last function 23 framed here (`_read_write`)
         self._answer = bytearray(9 + 2 * MAX_READ_REGISTERS)
+        self._out_places: dict[str, tuple[Signal, int, int]] = {}  # name -> (entry, first word, words) in the output window
 
     @classmethod
     def connect(cls, host: str = "127.0.0.1", port: int | None = None, unit_id: int = 1, *,
@@ -501,16 +504,23 @@ class TwinClient:
         """(first word, words) of the output window covering `values` (and sim.advance), the words between
         them filled with the values `image` holds (so they are written unchanged)."""
         lay = self.layout
+        places = self._out_places
         mine: dict[int, int] = {}
         for name, value in values.items():
-            s = lookup(self.map, name)
-            k, n = lay.out_words(s)
-            ws = [int(w) for w in encode(s, value if checked else check_value(self.map, name, value))]
+            place = places.get(name)
+            if place is None:
+                s = lookup(self.map, name)
+                place = places[name] = (s, *lay.out_words(s))
+            s, k, n = place
+            ws = encode(s, value if checked else check_value(self.map, name, value))
             for i in range(n):
-                mine[k + i] = ws[i]
+                mine[k + i] = int(ws[i])
         if advance:
-            s = lookup(self.map, ADVANCE)
-            mine[lay.out_words(s)[0]] = int(advance)
+            place = places.get(ADVANCE)
+            if place is None:
+                s = lookup(self.map, ADVANCE)
+                place = places[ADVANCE] = (s, *lay.out_words(s))
+            mine[place[1]] = int(advance)
         lo, hi = min(mine), max(mine)
         if hi - lo + 1 > MAX_RW_WRITE:
             return None
@@ -609,6 +619,48 @@ class TwinClient:
             delay = min(delay * 1.5, 0.001)
 
 
+class _ReadPlan:
+    """Where the names one scan reads sit in the input window, and their values as last read: a scan decodes only
+    the values whose words changed (most do not from one scan to the next)."""
+
+    def __init__(self, layout, signals: list[Signal]):
+        self.slots = [(s.name, s, *WindowImage.slot(layout, s)) for s in signals]  # (name, entry, word, words, bit)
+        at: dict[int, list[int]] = {}  # word of the window -> the slots that read it
+        for i, (_, _, k, n, _) in enumerate(self.slots):
+            for w in range(k, k + n):
+                at.setdefault(w, []).append(i)
+        self.indices = tuple(sorted(at))
+        self.readers = tuple(tuple(at[w]) for w in self.indices)
+        self.take = itemgetter(*self.indices) if len(self.indices) > 1 else (lambda ws, k=self.indices[0]: (ws[k],))
+        self.words: tuple | None = None  # the words read last time, and the values they gave
+        self.values: dict[str, Any] = {}
+
+    def values_of(self, words: list[int], decoded: dict[str, tuple]) -> dict[str, Any]:
+        """The values in `words` (the input window), decoding anew only those whose words changed since the last
+        call; `decoded`: name -> (its words or bit as last decoded, their value), shared by the plans."""
+        now = self.take(words)
+        last = self.words
+        if now == last:
+            return self.values
+        if last is None:
+            todo = range(len(self.slots))
+        else:
+            todo = sorted({i for readers in compress(self.readers, map(ne, now, last)) for i in readers})
+        values = dict(self.values)
+        slots = self.slots
+        for i in todo:
+            name, s, k, n, bit = slots[i]
+            raw = (words[k] >> bit) & 1 if bit >= 0 else words[k] if n == 1 else tuple(words[k:k + n])
+            seen = decoded.get(name)
+            if seen is not None and seen[0] == raw:  # another bit of the word changed, or another plan decoded it
+                values[name] = seen[1]
+            else:
+                values[name] = value = decode(s, [raw] if bit >= 0 else words[k:k + n])
+                decoded[name] = (raw, value)
+        self.words, self.values = now, values
+        return values
+
+
 class ClientIO(LocalSignals):
     """The network side of a scan cycle: `ScanCycle(ClientIO(client), logic)`.
 
@@ -634,7 +686,7 @@ class ClientIO(LocalSignals):
         self._image: WindowImage | None = None  # the input window as last read
         self._fresh = False  # it shows the process as it is now (lockstep: read after the last steps)
         self._pending: dict[str, Any] = {}  # lockstep: outputs to write with the next advance (checked)
-        self._reads: dict[tuple, list[tuple]] = {}  # the names a scan reads -> where each sits in the window
+        self._reads: dict[tuple, _ReadPlan] = {}  # the names a scan reads -> where each sits in the window
         self._decoded: dict[str, tuple] = {}  # name -> (its words or bit as last read, their value)
 
     def _read(self, names: list[str]) -> dict[str, Any]:
@@ -643,24 +695,13 @@ class ClientIO(LocalSignals):
         if not self.exchange:
             return self.client.read(*names)
         key = tuple(names)
-        slots = self._reads.get(key)
-        if slots is None:
-            slots = self._reads[key] = [(s.name, s, *WindowImage.slot(self.client.layout, s))
-                                        for s in check_names(self.client.map, names)]
+        plan = self._reads.get(key)
+        if plan is None:
+            plan = self._reads[key] = _ReadPlan(self.client.layout, check_names(self.client.map, names))
         if not self._fresh or self._image is None:
             self._image = self.client.read_window()
         self._fresh = self.lockstep  # real time: the next scan reads anew; lockstep: until the next advance
-        words, decoded = self._image.words, self._decoded
-        out = {}
-        for name, s, k, n, bit in slots:  # a value whose words did not change since the last read is not decoded again
-            raw = (words[k] >> bit) & 1 if bit >= 0 else words[k] if n == 1 else tuple(words[k:k + n])
-            last = decoded.get(name)
-            if last is not None and last[0] == raw:
-                out[name] = last[1]
-            else:
-                out[name] = value = decode(s, [raw] if bit >= 0 else words[k:k + n])
-                decoded[name] = (raw, value)
-        return out
+        return plan.values_of(self._image.words, self._decoded)
 
     def _write(self, values: dict[str, Any]) -> None:
         if not self.exchange:
