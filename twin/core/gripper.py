@@ -273,7 +273,8 @@ class Gripper:
         self._ticks = 0  # physics substeps since the joints were last read
         self._sent: tuple | None = None
         self._per_input = [(name, self.unit[name], MOVING_SPEED[self.unit[name]]) for name in self.names]
-        self._ranges = [(name, *self._range[name]) for name in self.names]
+        self._ranges = [(name, *self._range[name], IN_POSITION_TOLERANCE[self.unit[name]]) for name in self.names]
+        self._settled_statuses = [STATUS_AT_SETPOINT] * len(self.finger_links)
         self._servo_limits = {f: [(name, IN_POSITION_TOLERANCE[self.unit[name]], MOVING_SPEED[self.unit[name]])
                                   for name in servos] for f, servos in self.finger_servos.items()}
         self.read_along([])
@@ -583,14 +584,14 @@ class Gripper:
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
         axes, presses, series = self.state.axes, self._presses, self._series  # as the last step left them
         loads, holders = self._series_loads, self._series_holders
-        holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
-        index, series_share = self._index, self._series_share
         constants = self._constants
         if constants is None:
             constants = self._constants = self._drive_constants()
-        for (name, _, moving), (actual, joint_speed, _, _), moved, (
-                d, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads, in_holders,
-                in_series, own_share) in zip(self._per_input, states, self._speeds, constants):
+        holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
+        index, series_share = self._index, self._series_share
+        for (name, moving, _, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads,
+             in_holders, in_series, own_share, rigid, stiffness, damping, hold), (actual, joint_speed, _, _), moved in zip(
+                constants, states, self._speeds):
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
@@ -600,9 +601,6 @@ class Gripper:
                 way = None
                 target = g if in_holders else min(max(g, actual - full), actual + full)
             else:
-                # held: the joint moved slower than HELD_SHARE of its velocity limit the way its goal lies (last
-                # substep)
-                held = (moved if g > actual else -moved) < held_speed
                 if name in turned:
                     turned.discard(name)
                     if (g - actual) * (before - actual) < 0.0:
@@ -620,12 +618,15 @@ class Gripper:
                 else:
                     way = None
                     rate = velocity
-                    if (before - actual) * (g - actual) > 0.0 and pressing and held:
-                        # pressing on a part that holds the finger: full force within the rise time (a part that
-                        # gives way is pushed at the velocity limit, as a real servo's speed loop does, not run over by
-                        # the command)
+                    if ((before - actual) * (g - actual) > 0.0 and pressing
+                            and (moved if g > actual else -moved) < held_speed):
+                        # pressing on a part that holds the finger (held: the joint moved slower than HELD_SHARE of
+                        # its velocity limit the way its goal lies, last substep): full force within the rise time (a
+                        # part that gives way is pushed at the velocity limit, as a real servo's speed loop does, not
+                        # run over by the command)
                         rate = max(rate, rise_rate)
-                    target = _towards(before, g, rate * h)
+                    run = rate * h  # (the command moved towards its goal by at most that, landing exactly on it)
+                    target = g if abs(g - before) <= run else before + (run if g > before else -run)
                 # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
                 # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
                 # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
@@ -641,9 +642,8 @@ class Gripper:
             stalled[name] = way
             command[name] = target
             error = target - actual
-            toward = joint_speed if error > 0.0 else -joint_speed
             speed = error / h  # to be at the command after the substep, as far as the force allows
-            rigid = d.rigid  # stiffer than the step resolves (a station's choice): rigid up to its effort
+            # (rigid: stiffer than the step resolves, a station's choice: rigid up to its effort)
             leaning = False
             if pressing and in_loads:
                 if target != g:  # pressing through drives in series: leaning on those that stand at their goals
@@ -664,8 +664,8 @@ class Gripper:
                         if not share:
                             continue
                         gap = abs(goal[other] - states[index[other]][0]) + share * abs(g - actual)
-                        springs = 1.0 / (1.0 / do.stiffness + share * share / d.stiffness)
-                        if springs * gap >= LATCH_FRACTION * min(do.effort, d.effort / share):
+                        springs = 1.0 / (1.0 / do.stiffness + share * share / stiffness)
+                        if springs * gap >= LATCH_FRACTION * min(do.effort, effort / share):
                             rigid = True
                             now_holding.add(name)
                             break
@@ -676,7 +676,7 @@ class Gripper:
                 # out the share of it that its own links bear to the mass its gains were derived for (leaning on
                 # one that holds rigidly, it presses alone, as on a fine axis stiffer than the step resolves)
                 speed *= own_share
-            if abs(error) >= at_limit and toward <= 0.0:
+            if abs(error) >= at_limit and (joint_speed if error > 0.0 else -joint_speed) <= 0.0:
                 # at its force limit and held (or pushed) back: pybullet's solver builds a motor's force only as fast
                 # as the speed it asks for, so a held drive asks for far more than it can have: it presses at its limit
                 speed = max(abs(speed), PUSH_SPEEDUP * velocity) * (1.0 if error > 0.0 else -1.0)
@@ -695,9 +695,9 @@ class Gripper:
             if rigid:
                 forces.append(effort)
             else:
-                forces.append(min(effort, abs(d.stiffness * error - d.damping * joint_speed) + d.hold))
+                forces.append(min(effort, abs(stiffness * error - damping * joint_speed) + hold))
             quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
-                     and d.stiffness * abs(error) <= d.hold)  # a pressing drive: every substep
+                     and stiffness * abs(error) <= hold)  # a pressing drive: every substep
         self._quiet = quiet
         self._holding = now_holding
         if quiet and substep == 0 and self.substeps > 1:  # these settings hold for the whole step: the small error
@@ -710,17 +710,18 @@ class Gripper:
 
     def _drive_constants(self) -> list[tuple]:
         """Per input (`names` order), what `drive` asks of its drive at every substep, formed once (again after
-        `set_limits`): the drive, its full-force error, velocity, effort, the speed under which it is held, the force
-        rise's rate, its release, latch and follow errors, the error at its limit, whether it presses through drives
-        in series (and which hold others), whether it has springs in series, its own links' share of its mass."""
+        `set_limits`): its name, the speed under which it stands, the drive, its full-force error, velocity, effort,
+        the speed under which it is held, the force rise's rate, its release, latch and follow errors, the error at its
+        limit, whether it presses through drives in series (and which hold others), whether it has springs in series,
+        its own links' share of its mass, and the drive's rigidity, stiffness, damping and holding force."""
         out = []
-        for name in self.names:
+        for name, _, moving in self._per_input:
             d = self.drives[name]
             full = d.full
-            out.append((d, full, d.velocity, d.effort, HELD_SHARE * d.velocity, full / self.rise_time,
+            out.append((name, moving, d, full, d.velocity, d.effort, HELD_SHARE * d.velocity, full / self.rise_time,
                         RELEASE_FRACTION * full, full * LATCH_FRACTION, full * FOLLOW_FRACTION, full * (1.0 - 1e-9),
                         name in self._series_loads, name in self._series_holders, self._series[name] > 1,
-                        d.own / d.mass if d.mass else 0.0))
+                        d.own / d.mass if d.mass else 0.0, d.rigid, d.stiffness, d.damping, d.hold))
         return out
 
     def read_along(self, joints: list[int]) -> None:
@@ -816,12 +817,18 @@ class Gripper:
         self._step_positions, self._step_ticks = positions, 0
         axes = {}
         # (lo, hi: the joint's stop: the solver's give at a stop is no position the joint has)
-        for (name, lo, hi), q, before, effort in zip(self._ranges, positions, last, self._effort_sum):
+        for (name, lo, hi, _), q, before, effort in zip(self._ranges, positions, last, self._effort_sum):
             axes[name] = AxisState(min(max(q, lo), hi), (q - before) / dt, effort / n if measured else 0.0)
         self.state.axes = axes
         friction = self.spec.grip == "friction"
         if friction and not self._force_sum:  # no finger pressed on anything in this step: none touches (no query)
-            statuses = [self._status(f, axes, False) for f in self.finger_links]
+            goals = self._hold if self._hold is not None else self.setpoint
+            for name, _, _, tolerance in self._ranges:
+                if abs(goals[name] - axes[name].actual) > tolerance:
+                    statuses = [self._status(f, axes, False) for f in self.finger_links]
+                    break
+            else:  # every axis at its goal: what `_status` gives every finger touching nothing
+                statuses = self._settled_statuses
             if statuses != self._idle_statuses:  # (else the fingers' states of the step before hold, unchanged)
                 self.state.fingers = {f: FingerState((), 0, {}, status)  # (0: an empty sum)
                                       for f, status in zip(self.finger_links, statuses)}
@@ -990,8 +997,3 @@ def _rotate(orn, v):
     m = pybullet.getMatrixFromQuaternion(orn)
     return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
             m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
-
-
-def _towards(value: float, goal: float, step: float) -> float:
-    """`value` moved towards `goal` by at most `step`, landing exactly on it."""
-    return goal if abs(goal - value) <= step else value + (step if goal > value else -step)
