@@ -595,6 +595,29 @@ class Gripper:
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
+            if pressing and not in_loads and not in_series and name not in turned:
+                # pressing on a part alone (no drives in series), with no new goal: the two states a grip stands in,
+                # in short (what the loop below gives there, the same values)
+                way = stalled.get(name)
+                if way is None:
+                    held = before == g and (in_holders or actual - full <= g <= actual + full)
+                else:
+                    pushed = (before - actual) * way  # how far its command stands past the joint, the way it presses
+                    held = ((g - before) * way > 0.0 and pushed > release and pushed >= follow
+                            and actual - full <= before <= actual + full)
+                if held:  # its command at its goal (a setpoint within full force past the part), or stalled short of
+                    # it on a part that holds: the command stays, and so does its stall (its way)
+                    error = before - actual
+                    speed = error / h
+                    if abs(error) >= at_limit and (joint_speed if error > 0.0 else -joint_speed) <= 0.0:
+                        speed = max(abs(speed), PUSH_SPEEDUP * velocity) * (1.0 if error > 0.0 else -1.0)
+                    elif abs(speed) > velocity and moved * error >= held_speed * abs(error):
+                        speed = velocity if speed > 0.0 else -velocity
+                    velocities.append(speed)
+                    forces.append(effort if rigid else min(effort, abs(stiffness * error - damping * joint_speed) + hold))
+                    quiet = (quiet and way is None and abs(axes[name].velocity if axes else joint_speed) < moving
+                             and stiffness * abs(error) <= hold)
+                    continue
             if before == g and not pressing and name not in turned and stalled.get(name) is None:
                 # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the ramp
                 # below gives, in short: the goal itself, within full force of the joint unless others press through it

@@ -82,10 +82,7 @@ class Segment:
         self.corner_failure = False  # a zone point that became a stop point: its next motion came too late
         self.radius = 0.0  # the zone's radius as reduced for its neighbours (m), once its corner is planned
         self.lists = None  # (the queue's base it was formed for, that base and q0 as lists): `MotionQueue.command`
-
-    @property
-    def end(self) -> float:
-        return self.start + self.traj.duration
+        self.end = start + traj.duration  # when it ends on the motion clock (asked at every physics substep)
 
     def delta(self, t: float) -> np.ndarray:
         return self.traj.q(t - self.start) - self.q0
@@ -313,9 +310,7 @@ class PathClock:
     def tau(self, t: float) -> float:
         return self._phase(t)[0]
 
-    def at(self, t: float) -> tuple[float, float]:
-        """(tau, rate) at t, in one go (the robot asks at every physics substep)."""
-        return self._phase(t)
+    at = _phase  # (tau, rate) at t, in one go (the robot asks at every physics substep)
 
     def rate(self, t: float) -> float:
         return self._phase(t)[1]

@@ -322,7 +322,10 @@ class Robot:
                 self._hold, self._hold_for = queue.q(queue.end), traj
             self._command_hold(self._hold)
         elif rate == 1.0:
-            self._command(*queue.command(tau))
+            q, qd = queue.command(tau)  # (lists of floats: `_command` without its conversions)
+            self._held = None
+            self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=q, targetVelocities=qd,
+                         forces=self.forces, positionGains=self._gains[0], velocityGains=self._gains[1])
         else:  # StopMove / StartMove: on the path, at the clock's rate
             q, qd = queue.state(tau)
             self._command(q, qd * rate)
