@@ -619,10 +619,22 @@ class Gripper:
                              and stiffness * abs(error) <= hold)
                     continue
             if before == g and not pressing and name not in turned and stalled.get(name) is None:
-                # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the ramp
+                # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the loop
                 # below gives, in short: the goal itself, within full force of the joint unless others press through it
-                way = None
                 target = g if in_holders else min(max(g, actual - full), actual + full)
+                if target != g:
+                    command[name] = target
+                error = target - actual
+                speed = error / h
+                if abs(error) >= at_limit and (joint_speed if error > 0.0 else -joint_speed) <= 0.0:
+                    speed = max(abs(speed), PUSH_SPEEDUP * velocity) * (1.0 if error > 0.0 else -1.0)
+                elif abs(speed) > velocity and moved * error >= held_speed * abs(error):
+                    speed = velocity if speed > 0.0 else -velocity
+                velocities.append(speed)
+                forces.append(effort if rigid else min(effort, abs(stiffness * error - damping * joint_speed) + hold))
+                quiet = (quiet and abs(axes[name].velocity if axes else joint_speed) < moving
+                         and stiffness * abs(error) <= hold)
+                continue
             else:
                 if name in turned:
                     turned.discard(name)
