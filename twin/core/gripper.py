@@ -595,35 +595,27 @@ class Gripper:
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
+            short = False  # a drive in one of the states a cell stands in, which the loop below gives in short
             if pressing and not in_loads and not in_series and name not in turned:
-                # pressing on a part alone (no drives in series), with no new goal: the two states a grip stands in,
-                # in short (what the loop below gives there, the same values)
+                # pressing on a part alone (no drives in series), with no new goal: its command at its goal (a setpoint
+                # within full force past the part), or stalled short of it on a part that holds: the command stays,
+                # and so does its stall (its way)
                 way = stalled.get(name)
                 if way is None:
-                    held = before == g and (in_holders or actual - full <= g <= actual + full)
+                    short = before == g and (in_holders or actual - full <= g <= actual + full)
                 else:
                     pushed = (before - actual) * way  # how far its command stands past the joint, the way it presses
-                    held = ((g - before) * way > 0.0 and pushed > release and pushed >= follow
-                            and actual - full <= before <= actual + full)
-                if held:  # its command at its goal (a setpoint within full force past the part), or stalled short of
-                    # it on a part that holds: the command stays, and so does its stall (its way)
-                    error = before - actual
-                    speed = error / h
-                    if abs(error) >= at_limit and (joint_speed if error > 0.0 else -joint_speed) <= 0.0:
-                        speed = max(abs(speed), PUSH_SPEEDUP * velocity) * (1.0 if error > 0.0 else -1.0)
-                    elif abs(speed) > velocity and moved * error >= held_speed * abs(error):
-                        speed = velocity if speed > 0.0 else -velocity
-                    velocities.append(speed)
-                    forces.append(effort if rigid else min(effort, abs(stiffness * error - damping * joint_speed) + hold))
-                    quiet = (quiet and way is None and abs(axes[name].velocity if axes else joint_speed) < moving
-                             and stiffness * abs(error) <= hold)
-                    continue
-            if before == g and not pressing and name not in turned and stalled.get(name) is None:
-                # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): what the loop
-                # below gives, in short: the goal itself, within full force of the joint unless others press through it
+                    short = ((g - before) * way > 0.0 and pushed > release and pushed >= follow
+                             and actual - full <= before <= actual + full)
+                target = before
+            elif before == g and not pressing and name not in turned and stalled.get(name) is None:
+                # standing at its goal, pressing on nothing (a cell at rest, a drive the arm carries): the goal itself,
+                # within full force of the joint unless others press through it
+                way, short = None, True
                 target = g if in_holders else min(max(g, actual - full), actual + full)
                 if target != g:
                     command[name] = target
+            if short:  # (the same values as the loop below, without the cases that cannot arise here)
                 error = target - actual
                 speed = error / h
                 if abs(error) >= at_limit and (joint_speed if error > 0.0 else -joint_speed) <= 0.0:
@@ -632,48 +624,47 @@ class Gripper:
                     speed = velocity if speed > 0.0 else -velocity
                 velocities.append(speed)
                 forces.append(effort if rigid else min(effort, abs(stiffness * error - damping * joint_speed) + hold))
-                quiet = (quiet and abs(axes[name].velocity if axes else joint_speed) < moving
+                quiet = (quiet and way is None and abs(axes[name].velocity if axes else joint_speed) < moving
                          and stiffness * abs(error) <= hold)
                 continue
+            if name in turned:
+                turned.discard(name)
+                if (g - actual) * (before - actual) < 0.0:
+                    before = actual  # a new goal the other way: the drive turns at once, from where the joint is
+                    stalled[name] = None
+            way = stalled.get(name)
+            if way is not None and (g - before) * way > 0.0 and (before - actual) * way > release:
+                # stalled on a part: the command waits, so the finger holds where the part stopped it
+                target = before
+                if (target - actual) * way < follow:
+                    # the part gave way: followed, pressing as stalled
+                    target = actual + way * latch
+                    if (g - target) * way < 0.0:
+                        target = g
             else:
-                if name in turned:
-                    turned.discard(name)
-                    if (g - actual) * (before - actual) < 0.0:
-                        before = actual  # a new goal the other way: the drive turns at once, from where the joint is
-                        stalled[name] = None
-                way = stalled.get(name)
-                if way is not None and (g - before) * way > 0.0 and (before - actual) * way > release:
-                    # stalled on a part: the command waits, so the finger holds where the part stopped it
-                    target = before
-                    if (target - actual) * way < follow:
-                        # the part gave way: followed, pressing as stalled
-                        target = actual + way * latch
-                        if (g - target) * way < 0.0:
-                            target = g
-                else:
-                    way = None
-                    rate = velocity
-                    if ((before - actual) * (g - actual) > 0.0 and pressing
-                            and (moved if g > actual else -moved) < held_speed):
-                        # pressing on a part that holds the finger (held: the joint moved slower than HELD_SHARE of
-                        # its velocity limit the way its goal lies, last substep): full force within the rise time (a
-                        # part that gives way is pushed at the velocity limit, as a real servo's speed loop does, not
-                        # run over by the command)
-                        rate = max(rate, rise_rate)
-                    run = rate * h  # (the command moved towards its goal by at most that, landing exactly on it)
-                    target = g if abs(g - before) <= run else before + (run if g > before else -run)
-                # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
-                # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
-                # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
-                if target != g or not in_holders:
-                    target = min(max(target, actual - full), actual + full)
-                if (target != g and abs(target - actual) >= latch
-                        and (g - actual) * (target - actual) > 0.0 and pressing):
-                    if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on
-                        # past it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
-                        target = actual + (1.0 if target > actual else -1.0) * latch
-                    # held short of its goal by a part, at its force limit: stalled
-                    way = 1.0 if target > actual else -1.0
+                way = None
+                rate = velocity
+                if ((before - actual) * (g - actual) > 0.0 and pressing
+                        and (moved if g > actual else -moved) < held_speed):
+                    # pressing on a part that holds the finger (held: the joint moved slower than HELD_SHARE of
+                    # its velocity limit the way its goal lies, last substep): full force within the rise time (a
+                    # part that gives way is pushed at the velocity limit, as a real servo's speed loop does, not
+                    # run over by the command)
+                    rate = max(rate, rise_rate)
+                run = rate * h  # (the command moved towards its goal by at most that, landing exactly on it)
+                target = g if abs(g - before) <= run else before + (run if g > before else -run)
+            # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
+            # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
+            # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
+            if target != g or not in_holders:
+                target = min(max(target, actual - full), actual + full)
+            if (target != g and abs(target - actual) >= latch
+                    and (g - actual) * (target - actual) > 0.0 and pressing):
+                if way is None:  # stalls now: at exactly that error, however far its ramp's last substep ran on
+                    # past it, so fingers that stall a substep apart press alike (a squeezed part does not jump)
+                    target = actual + (1.0 if target > actual else -1.0) * latch
+                # held short of its goal by a part, at its force limit: stalled
+                way = 1.0 if target > actual else -1.0
             stalled[name] = way
             command[name] = target
             error = target - actual
