@@ -582,14 +582,13 @@ class Gripper:
         velocities, forces = [], []
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
-        axes, presses, series = self.state.axes, self._presses, self._series  # as the last step left them
-        loads, holders = self._series_loads, self._series_holders
+        axes, presses, loads = self.state.axes, self._presses, self._series_loads  # as the last step left them
         constants = self._constants
         if constants is None:
             constants = self._constants = self._drive_constants()
         holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
         index, series_share = self._index, self._series_share
-        for (name, moving, _, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads,
+        for (name, moving, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads,
              in_holders, in_series, own_share, rigid, stiffness, damping, hold), (actual, joint_speed, _, _), moved in zip(
                 constants, states, self._speeds):
             g = goal[name]
@@ -736,7 +735,7 @@ class Gripper:
 
     def _drive_constants(self) -> list[tuple]:
         """Per input (`names` order), what `drive` asks of its drive at every substep, formed once (again after
-        `set_limits`): its name, the speed under which it stands, the drive, its full-force error, velocity, effort,
+        `set_limits`): its name, the speed under which it stands, its full-force error, velocity, effort,
         the speed under which it is held, the force rise's rate, its release, latch and follow errors, the error at its
         limit, whether it presses through drives in series (and which hold others), whether it has springs in series,
         its own links' share of its mass, and the drive's rigidity, stiffness, damping and holding force."""
@@ -744,7 +743,7 @@ class Gripper:
         for name, _, moving in self._per_input:
             d = self.drives[name]
             full = d.full
-            out.append((name, moving, d, full, d.velocity, d.effort, HELD_SHARE * d.velocity, full / self.rise_time,
+            out.append((name, moving, full, d.velocity, d.effort, HELD_SHARE * d.velocity, full / self.rise_time,
                         RELEASE_FRACTION * full, full * LATCH_FRACTION, full * FOLLOW_FRACTION, full * (1.0 - 1e-9),
                         name in self._series_loads, name in self._series_holders, self._series[name] > 1,
                         d.own / d.mass if d.mass else 0.0, d.rigid, d.stiffness, d.damping, d.hold))

@@ -344,8 +344,5 @@ class Robot:
 
 
 def _floats(values) -> list[float]:
-    """Python floats for pybullet (an array's `tolist` gives the very same values, without a loop in Python; a list
-    is taken as it is: the motion queue's `command` gives lists of floats at every substep)."""
-    if type(values) is list:
-        return values
+    """Python floats for pybullet (an array's `tolist` gives the very same values, without a loop in Python)."""
     return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]

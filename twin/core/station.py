@@ -170,8 +170,6 @@ class Station:
 
 _TYPE_NAMES = {float: "number", str: "string", int: "integer", bool: "bool", list: "list", dict: "table"}
 
-
-
 MIN_SUBSTEPS = 4  # physics substeps per step at the least, by default ...
 MAX_SUBSTEP = 0.003  # s: ... and more where the step is longer than 4 of these: the stiffest drive a substep keeps
 # stable for a finger's mass falls as 1 / substep^2, and a slow step's soft drives fall short of their effort (at a
@@ -183,6 +181,7 @@ def default_substeps(step: float) -> int:
     """The physics substeps of a step when the station does not say: at least MIN_SUBSTEPS, none longer than
     MAX_SUBSTEP (12 ms: 4; 20 ms: 7), at most the 100 a station may give."""
     return min(100, max(MIN_SUBSTEPS, math.ceil(step / MAX_SUBSTEP - 1e-9)))
+
 
 def _all_numbers(values: list) -> bool:
     """Every value a finite number (TOML has nan and inf: they would poison the physics)."""

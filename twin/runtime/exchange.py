@@ -111,10 +111,7 @@ class Exchange:
 
     def check(self, name: str, value):
         """A write's value, normalised, or the error every front end reports (see the module docstring)."""
-        try:
-            spec = self._spec[name]
-        except KeyError:
-            raise SignalError(name, "no such signal") from None
+        spec = self.spec(name)
         value = spec.check(value)
         if name == SIM_ADVANCE:
             runner = self.runner
