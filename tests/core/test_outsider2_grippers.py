@@ -441,20 +441,12 @@ def _status_settles(run: Run, spec: Spec):
 
 
 KNOWN = {
-    # (measure, gripper) -> what fails, as measured on main at 5b5d818
+    # (measure, gripper) -> what fails, as measured on main at 5b5d818 (fast fingers: fixed since by their arrival)
     ("force", "chuck"): "one-input 3-jaw chuck (mimics 1:1 and -1+0.06; the same with three 1:1 jaws): the jaws press "
                         "40.6 / 28.3 / 20.7 N on the disc where virtual work gives 90 / 3 = 30 N each (sum 89.6 N)",
     ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
     ("contact", "bore"): "opening into the bore, the step before the jaws' contact flags rose they stood 0.08 mm into the "
                          "bore's wall (all three; 0.06 mm when it rose): the flag is a step late",
-    ("status", "quad_fast"): "fingers at 0.5 m/s (station velocity): status 2 only 11-12 steps after touching (the "
-                             "pads 1.1-1.3 mm into the cube the step their flags rose)",
-    ("still", "quad_fast"): "fingers at 0.5 m/s: f_px and f_py `moving` in the hold's first step",
-    ("status", "feather_fast"): "1 N fingers at 0.5 m/s on the 5 g cube: tip_b reads 2, 0, 2 and settles 14 steps after "
-                                "touching",
-    ("still", "feather_fast"): "1 N fingers at 0.5 m/s: tip_b `moving` in 2 steps of the hold",
-    ("push", "feather_fast"): "1 N fingers at 0.5 m/s from equal 7.5 mm gaps: the centred 5 g cube is pushed 3.0 mm "
-                              "(tip_b 2.2 mm into it the step its flag rose)",
     ("force", "lever3"): "one-input 3-lever revolute chuck (two 1:1 mimics), 3 N m: the levers hold 1.37 / 0.87 / "
                          "0.73 N m where virtual work gives 1 N m each",
     ("penetration", "lever3"): "lever_1 (the input) stands 0.32 mm into the disc; were the followers where the URDF's "
@@ -462,8 +454,10 @@ KNOWN = {
                                "into it (the disc pushed 0.75 mm towards them); twin check reads 0.30 and 0.24 mm for "
                                "them: the followers stand ~15-25 mrad behind the master, the mimic coupling yields",
     ("push", "lever3"): "the centred disc (equal gaps, one drive) is pushed 0.75 mm by the unequal levers (limit 0.5)",
-    ("status", "lever3"): "status 0 for one step 24 steps after touching (0x7 2x17 0x1 2x403 on all three levers)",
-    ("still", "lever3"): "`moving` on for one step of the hold (the same step), spread 0.27 mrad",
+    ("contact", "lever3"): "this test's lever model (the tip corner at 0.045 - 0.06 sin(theta), followers at the master's "
+                           "angle) reads 0.2-0.3 mm deeper than the URDF's shapes as pybullet holds them (see penetration): "
+                           "levers that now arrive slowed (gripper.py ARRIVAL_TRAVEL) stand 0.03 mm short of the disc by "
+                           "pybullet's getClosestPoints the step before their flags rise, 0.21 mm into it by the model",
 }
 
 
@@ -855,3 +849,26 @@ def test_after_carrying_the_block_each_jaw_presses_with_its_drives_effort():
     run = heavy_arm_run(7.0)
     assert run["gripped"]
     assert all(abs(v - 2000.0) <= 200.0 for v in run["force"].values()), run
+
+
+@pytest.mark.parametrize("key", ["feather_fast", "quad_fast"])
+def test_fast_fingers_slow_down_for_a_part_but_not_to_leave_it(key, tmp_path):
+    # fingers at 0.5 m/s (the station's velocity) slow down to arrive at a part, not to leave it: opened from the
+    # grip, each moves the first step at its velocity limit, 6 mm in 12 ms; and it had reached the part's side
+    # (its own gap to the centred part) without pushing it
+    spec = SPECS[key]
+    with Twin.from_station(edited_station(spec, tmp_path)) as tw:
+        tw.step(int(round((spec.settle + spec.rest) / 0.012)))  # (as `grip`: the part at rest, frozen, first)
+        p0 = tw.object_pose(spec.target)[0]
+        start = {i: tw.read(i + ".actual") for i in spec.close}
+        for name, value in spec.close.items():
+            tw.write(name, value)
+        tw.step(40)
+        assert all(tw.read(f + ".status") == 2 for f in spec.fingers)
+        assert dist3(tw.object_pose(spec.target)[0], p0) < 0.0005
+        closed = {i: tw.read(i + ".actual") for i in spec.close}
+        for i in spec.close:
+            tw.write(i, start[i])
+        tw.step()
+        for i in spec.close:
+            assert abs(tw.read(i + ".actual") - closed[i]) >= 0.9 * 0.5 * 0.012, (i, closed[i], tw.read(i + ".actual"))

@@ -92,6 +92,13 @@ GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's driv
 LOST_WATCH_STEPS = 25  # a gripped part no finger presses on any more, and that no setpoint let go, is watched for
 # slip this many steps more (0.3 s at 12 ms): a dropped part leaves the fingers within a step
 RELEASE_SHARE = 0.25  # a grip lasts while every finger presses with this share of grip_force (no flicker)
+ARRIVAL_TRAVEL = 0.0003  # m: a finger reaches a part moving at most this far a substep (0.1 m/s at 3 ms). A drive
+# whose fingers may move further at its velocity limit (a fast finger: 1.5 mm a substep at 0.5 m/s) slows down within
+# sight of a target: pybullet's box contacts exist only once shapes overlap, so a fast finger is stopped a whole
+# substep's travel deep in the part (2.2 mm at 0.5 m/s), kicks it, and is pushed back out over a dozen steps
+ARRIVAL_DEPTH = 0.00002  # m: ... and its last substep before the part lands it this far into it (pybullet's contacts
+# exist once shapes overlap; a contact flag must not rise a step late)
+ARRIVAL_BRAKING = 0.5  # the share of a drive's effort over its own links' mass that slowing down for a part may ask
 CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
 _warned_efforts: set[str] = set()  # each unreachable or defaulted limit warned of once per process
 
@@ -264,6 +271,7 @@ class Gripper:
                            for link, finger in self._finger_of_link.items()
                            for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
         self._quiet = False
+        self._gaps: dict[str, float] = {}  # per fast drive: its fingers' gap to the nearest target, last substep
         # the joints' states as last read (after the last physics substep: what the next drive starts from), and
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
         self._states = None
@@ -362,6 +370,9 @@ class Gripper:
         carriers = {name for name in self.names if finger_links & {k for k, _ in moved[name]}}
         share = max(1, len({servos[0] for servos in self.finger_servos.values() if servos}))  # the fingers' own drives
         self.finger_forces: dict[str, float] = {}  # N: what each finger-carrying drive presses a finger with, at most
+        # per finger-carrying drive: the finger links it moves, and how fast the fastest of their points moves for a
+        # unit of the joint's speed (a mimic's multiplier; a revolute drive: its fingers' reach), for `_arrival`
+        self._finger_travel: dict[str, tuple[list[int], float]] = {}
         for name in self.names:
             d, links = self.drives[name], moved[name]
             fingers = name in carriers
@@ -371,8 +382,12 @@ class Gripper:
                 mass, floor = own + (part if fingers else 0.0), 1e-3
                 if fingers:
                     self.finger_forces[name] = d.effort / jaws
+                    self._finger_travel[name] = ([k for k, _ in links if k in finger_links],
+                                                 max(abs(m) for k, m in links if k in finger_links))
             else:
                 own, reach = self._inertia_about_axis(name, links, finger_links)
+                if fingers and reach > 0.0:
+                    self._finger_travel[name] = ([k for k, _ in links if k in finger_links], reach)
                 mass, floor = own + (part * reach * reach if fingers else 0.0), 1e-7
                 if fingers and reach > 0.0:
                     self.finger_forces[name] = d.effort / reach / jaws  # at the fingers' reach
@@ -589,7 +604,7 @@ class Gripper:
         holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
         index, series_share = self._index, self._series_share
         for (name, moving, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads,
-             in_holders, in_series, own_share, rigid, stiffness, damping, hold), (actual, joint_speed, _, _), moved in zip(
+             in_holders, in_series, own_share, rigid, stiffness, damping, hold, arrival), (actual, joint_speed, _, _), moved in zip(
                 constants, states, self._speeds):
             g = goal[name]
             before = command[name]
@@ -709,6 +724,8 @@ class Gripper:
                 # running free (a part that gives way, a finger catching up): never faster than the velocity limit;
                 # a held joint asks for more (the solver builds the force against the part from that speed)
                 speed = velocity if speed > 0.0 else -velocity
+            if arrival is not None and way is None and not pressing:
+                speed = self._arrival(name, arrival, speed)
             velocities.append(speed)
             if leaning:
                 # pressing through drives in series that stand at their goals (a carriage through its fine axis):
@@ -746,8 +763,43 @@ class Gripper:
             out.append((name, moving, full, d.velocity, d.effort, HELD_SHARE * d.velocity, full / self.rise_time,
                         RELEASE_FRACTION * full, full * LATCH_FRACTION, full * FOLLOW_FRACTION, full * (1.0 - 1e-9),
                         name in self._series_loads, name in self._series_holders, self._series[name] > 1,
-                        d.own / d.mass if d.mass else 0.0, d.rigid, d.stiffness, d.damping, d.hold))
+                        d.own / d.mass if d.mass else 0.0, d.rigid, d.stiffness, d.damping, d.hold,
+                        self._arrival_constants(name, d)))
         return out
+
+    def _arrival_constants(self, name: str, d: Drive) -> tuple | None:
+        """For a drive whose fingers may move further than ARRIVAL_TRAVEL in a substep: its finger links, their
+        travel per unit of its speed, the deceleration they may slow down with, and how far ahead a part is looked
+        for (from there on they slow down; a substep's travel more). Else None."""
+        links, rate = self._finger_travel.get(name, ((), 0.0))
+        fastest = d.velocity * rate  # m/s at the fingers
+        if not links or fastest * self.h <= ARRIVAL_TRAVEL * (1.0 + 1e-9) or d.effort <= 0.0:
+            return None
+        braking = ARRIVAL_BRAKING * d.effort / max(d.own, 1e-9) * rate  # m/s^2 at the fingers
+        sight = max(2.0 * self.h * fastest, fastest * fastest / braking) + fastest * self.h
+        return links, rate, braking, sight
+
+    def _arrival(self, name: str, arrival: tuple, speed: float) -> float:
+        """`speed` (a drive's, running free), slowed down so that its fingers reach a target gently: within sight of
+        one and nearing it, they close half the gap a substep (no faster than the drive can still brake from,
+        sqrt(a gap)) until that is slower than ARRIVAL_TRAVEL a substep; then they move on at that, the last
+        substep landing ARRIVAL_DEPTH into the part. Moving away from a part, they are not slowed."""
+        links, rate, braking, sight = arrival
+        c, body, near, h = self.client, self.body, self._target_by_id, self.h
+        gap = sight
+        for link in links:
+            lo, hi = c.getAABB(body, link)
+            found = c.getOverlappingObjects([x - sight for x in lo], [x + sight for x in hi]) or ()
+            for uid in {uid for uid, _ in found if uid in near}:
+                for pt in c.getClosestPoints(body, uid, sight, linkIndexA=link):
+                    gap = min(gap, pt[8])
+        last, self._gaps[name] = self._gaps.get(name), gap
+        if gap >= sight or (last is not None and gap > last):
+            return speed
+        gap = max(gap, 0.0)
+        final = min(ARRIVAL_TRAVEL, gap + ARRIVAL_DEPTH) / h
+        cap = min(max(gap / (2.0 * h), final), final + math.sqrt(braking * gap)) / rate
+        return speed if abs(speed) <= cap else (cap if speed > 0.0 else -cap)
 
     def read_along(self, joints: list[int]) -> None:
         """Read `joints` (of the same body) with the inputs' joints after each step's last substep, into `along`
