@@ -441,23 +441,19 @@ def _status_settles(run: Run, spec: Spec):
 
 
 KNOWN = {
-    # (measure, gripper) -> what fails, as measured on main at 5b5d818 (fast fingers: fixed since by their arrival)
+    # (measure, gripper) -> what fails, as measured on main at 5b5d818 (fast fingers and late contact flags: fixed since)
     ("force", "chuck"): "one-input 3-jaw chuck (mimics 1:1 and -1+0.06; the same with three 1:1 jaws): the jaws press "
                         "40.6 / 28.3 / 20.7 N on the disc where virtual work gives 90 / 3 = 30 N each (sum 89.6 N)",
     ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
-    ("contact", "bore"): "opening into the bore, the step before the jaws' contact flags rose they stood 0.08 mm into the "
-                         "bore's wall (all three; 0.06 mm when it rose): the flag is a step late",
     ("force", "lever3"): "one-input 3-lever revolute chuck (two 1:1 mimics), 3 N m: the levers hold 1.37 / 0.87 / "
                          "0.73 N m where virtual work gives 1 N m each",
     ("penetration", "lever3"): "lever_1 (the input) stands 0.32 mm into the disc; were the followers where the URDF's "
                                "mimic puts them (the master's angle), lever_2 and lever_3 would stand 1.05 and 1.67 mm "
                                "into it (the disc pushed 0.75 mm towards them); twin check reads 0.30 and 0.24 mm for "
-                               "them: the followers stand ~15-25 mrad behind the master, the mimic coupling yields",
+                               "them: the followers stand ~15-25 mrad behind the master, the mimic coupling yields (and "
+                               "this test's tip model reads ~0.27 mm deeper than pybullet's shapes: getClosestPoints "
+                               "has lever_1 0.04-0.06 mm into the disc)",
     ("push", "lever3"): "the centred disc (equal gaps, one drive) is pushed 0.75 mm by the unequal levers (limit 0.5)",
-    ("contact", "lever3"): "this test's lever model (the tip corner at 0.045 - 0.06 sin(theta), followers at the master's "
-                           "angle) reads 0.2-0.3 mm deeper than the URDF's shapes as pybullet holds them (see penetration): "
-                           "levers that now arrive slowed (gripper.py ARRIVAL_TRAVEL) stand 0.03 mm short of the disc by "
-                           "pybullet's getClosestPoints the step before their flags rise, 0.21 mm into it by the model",
 }
 
 

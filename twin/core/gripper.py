@@ -38,7 +38,7 @@ and contact forces true (measured-facts.md: numSubSteps distorts both).
 The grip rule (`sense`, after each step), the same for outside and inside grips:
 - contact: a finger touches a target when their closest distance (with 0.1 mm collision margins, so corners
   are sharp) is at most `contact_distance` (0 by default: never before true contact); in `friction` mode it
-  also has to press on it (a normal force);
+  also has to press on it (a normal force), or, moving, overlap it (it reached the part in the step's last substep);
 - `doGripped` / `GrippedPart`: every finger presses on the same target with at least `grip_force`; the grip
   lasts while every finger presses with at least a quarter of it (a swinging part does not make it flicker);
 - `grip = "friction"`: nothing is welded, the part is held by friction alone and may slip or drop;
@@ -898,7 +898,9 @@ class Gripper:
             axes[name] = AxisState(min(max(q, lo), hi), (q - before) / dt, effort / n if measured else 0.0)
         self.state.axes = axes
         friction = self.spec.grip == "friction"
-        if friction and not self._force_sum:  # no finger pressed on anything in this step: none touches (no query)
+        reached = self._reached(axes) if friction else {}
+        if friction and not self._force_sum and not reached:  # no finger pressed on anything in this step, and
+            # none that moves overlaps a target: none touches
             goals = self._hold if self._hold is not None else self.setpoint
             for name, _, _, tolerance in self._ranges:
                 if abs(goals[name] - axes[name].actual) > tolerance:
@@ -925,12 +927,15 @@ class Gripper:
         for finger in self.finger_links:
             pressed = pressing.get(finger)
             on = {t: pressed[t] for t in self.targets if pressed.get(t, 0.0) > 0.0} if pressed else {}
-            # friction mode: no contact without a normal force, so a finger pressing on nothing needs no query
+            # friction mode: no contact without a normal force (or, moving, an overlap: `_reached`), so a finger
+            # pressing on nothing needs no query
             if on and friction and all(f >= self._release_force[finger] for f in on.values()):
                 touching = tuple(on)  # pressing with a quarter of its grip force or more: touching, no query needed
             else:
                 touching = self._touching(finger, CONTACT_SLACK) if on else () if friction else self._touching(finger)
             contacts = tuple(t for t in touching if not friction or t in on)
+            if finger in reached:
+                contacts = tuple(t for t in self.targets if t in contacts or t in reached[finger])
             force = sum(on.values())
             fingers[finger] = FingerState(contacts, force, on, self._status(finger, axes, bool(contacts)))
         self.state.fingers = fingers
@@ -977,9 +982,23 @@ class Gripper:
         return [t for t in names if all(t in f.contacts and f.pressing.get(t, 0.0) >= threshold[name]
                                         for name, f in fingers.items())]
 
-    def _touching(self, finger: str, slack: float = 0.0) -> tuple[str, ...]:
-        """Targets within contact_distance (+ slack) of the finger's true shape (never before they touch)."""
-        c, d = self.client, max(self.spec.contact_distance, slack)
+    def _reached(self, axes: dict[str, AxisState]) -> dict[str, tuple[str, ...]]:
+        """Friction mode: the targets that fingers moving in this step, and pressing on nothing, overlap (their true
+        shapes). Such a finger reached the part in the step's last substep: pybullet's contact, and its force, come
+        with the next substep, and its flag would rise a step late (0.1 mm into the part at 0.04 m/s)."""
+        out = {}
+        pressed = {finger for finger, _ in self._force_sum}
+        for finger, servos in self._servo_limits.items():
+            if finger not in pressed and any(abs(axes[name].velocity) > moving for name, _, moving in servos):
+                touching = self._touching(finger, within=0.0)
+                if touching:
+                    out[finger] = touching
+        return out
+
+    def _touching(self, finger: str, slack: float = 0.0, within: float | None = None) -> tuple[str, ...]:
+        """Targets within contact_distance (+ slack; or `within`) of the finger's true shape (never before they
+        touch)."""
+        c, d = self.client, max(self.spec.contact_distance, slack) if within is None else within
         found: set[str] = set()
         for link in self.finger_links[finger]:
             lo, hi = c.getAABB(self.body, link)
