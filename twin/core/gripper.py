@@ -86,6 +86,9 @@ SERIES_HOLD = 1.0 - (1.0 - LATCH_FRACTION - HOLD_FRACTION) / 2  # a drive pressi
 RELEASE_FRACTION = 0.9  # a stalled drive moves its command on again once its force has fallen by a tenth
 HELD_SHARE = 0.5  # a joint that moved less than this share of its velocity limit the drive's way (over the last
 # substep) is held: only then does its command run on to build force, and may it ask for more than its limit's speed
+RESTING_DRIFT = 2.0  # resting drives (`_still_resting`) rest on while each joint stays within this many times the
+# error a quiet drive's holding force allows of its command (at most half its in-position tolerance); past it (a push,
+# a load the holding force gives way to) the loop takes over again
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
 GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's drive effort
@@ -271,6 +274,7 @@ class Gripper:
                            for link, finger in self._finger_of_link.items()
                            for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
         self._quiet = False
+        self._resting: tuple | None = None  # (Active, per input the joint's bounds) while the drives rest
         self._gaps: dict[str, float] = {}  # per fast drive: its fingers' gap to the nearest target, last substep
         # the joints' states as last read (after the last physics substep: what the next drive starts from), and
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
@@ -585,6 +589,10 @@ class Gripper:
         self._ticks += 1
         if substep and self._quiet:
             return
+        if self._resting is not None:
+            if self._still_resting():
+                return
+            self._resting = None
         if not self.active and self._hold is None:
             self._hold = dict(self.command_position)
         elif self.active:
@@ -740,15 +748,41 @@ class Gripper:
                 forces.append(min(effort, abs(stiffness * error - damping * joint_speed) + hold))
             quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
                      and stiffness * abs(error) <= hold)  # a pressing drive: every substep
-        self._quiet = quiet
-        self._holding = now_holding
+        if quiet and self._quiet and substep == 0:
+            # quiet for a second step: the drives rest (`_still_resting`), each held where its command stands by
+            # pybullet's own position motor, taking out a substeps-th of its error at each substep (what the
+            # loop asks of a quiet drive), with the force the loop gives it
+            self._motors(self.body, self._joint_ids, pybullet.POSITION_CONTROL,
+                         targetPositions=[command[name] for name in self.names], targetVelocities=[0.0] * len(forces),
+                         forces=forces, positionGains=[1.0 / self.substeps] * len(forces),
+                         velocityGains=[1.0] * len(forces))
+            self._sent = None  # (the loop's next command is sent whatever it is)
+            bounds = []
+            for name, unit, _ in self._per_input:
+                d = drives[name]
+                allowed = min(RESTING_DRIFT * d.hold / d.stiffness if d.stiffness else 0.0,
+                              0.5 * IN_POSITION_TOLERANCE[unit])
+                bounds.append((command[name] - allowed, command[name] + allowed))
+            self._resting = (self.active, bounds)
+            self._quiet, self._holding = quiet, now_holding
+            return
         if quiet and substep == 0 and self.substeps > 1:  # these settings hold for the whole step: the small error
             velocities = [v / self.substeps for v in velocities]  # left is taken out over it, not in every substep
+        self._quiet = quiet
+        self._holding = now_holding
         sent = (velocities, forces)
         if sent != self._sent:  # pybullet keeps a motor's command: the same one needs no call
             self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
                          forces=forces)
             self._sent = sent
+
+    def _still_resting(self) -> bool:
+        """Whether resting drives rest on: each holds where its command stands (pybullet's position motor, with the
+        force the quiet step gave it), and nothing in them is worked out at all while no setpoint, limit or `Active`
+        changes, no finger presses on a part, and every joint stays within its bounds (`sense` looks): RESTING_DRIFT
+        times the error a quiet drive's holding force allows, at most half its in-position tolerance. (A cell at rest
+        asked for its drives' whole loop at every step: a third of the twin's own Python there.)"""
+        return not (self._new_goal or self.pressing or self._constants is None or self._resting[0] != self.active)
 
     def _drive_constants(self) -> list[tuple]:
         """Per input (`names` order), what `drive` asks of its drive at every substep, formed once (again after
@@ -897,17 +931,25 @@ class Gripper:
         for (name, lo, hi, _), q, before, effort in zip(self._ranges, positions, last, self._effort_sum):
             axes[name] = AxisState(min(max(q, lo), hi), (q - before) / dt, effort / n if measured else 0.0)
         self.state.axes = axes
+        if self._resting is not None:  # resting drives rest on while each joint stays within its bounds
+            for q, (lo, hi) in zip(positions, self._resting[1]):
+                if not lo <= q <= hi:
+                    self._resting = None  # (the next step's loop takes the error out, and its command is sent)
+                    break
         friction = self.spec.grip == "friction"
         reached = self._reached(axes) if friction else {}
         if friction and not self._force_sum and not reached:  # no finger pressed on anything in this step, and
             # none that moves overlaps a target: none touches
             goals = self._hold if self._hold is not None else self.setpoint
-            for name, _, _, tolerance in self._ranges:
-                if abs(goals[name] - axes[name].actual) > tolerance:
-                    statuses = [self._status(f, axes, False) for f in self.finger_links]
-                    break
-            else:  # every axis at its goal: what `_status` gives every finger touching nothing
+            if self._resting is not None:  # (each joint within half its in-position tolerance of its goal)
                 statuses = self._settled_statuses
+            else:
+                for name, _, _, tolerance in self._ranges:
+                    if abs(goals[name] - axes[name].actual) > tolerance:
+                        statuses = [self._status(f, axes, False) for f in self.finger_links]
+                        break
+                else:  # every axis at its goal: what `_status` gives every finger touching nothing
+                    statuses = self._settled_statuses
             if statuses != self._idle_statuses:  # (else the fingers' states of the step before hold, unchanged)
                 self.state.fingers = {f: FingerState((), 0, {}, status)  # (0: an empty sum)
                                       for f, status in zip(self.finger_links, statuses)}
@@ -987,12 +1029,20 @@ class Gripper:
         shapes). Such a finger reached the part in the step's last substep: pybullet's contact, and its force, come
         with the next substep, and its flag would rise a step late (0.1 mm into the part at 0.04 m/s)."""
         out = {}
-        pressed = {finger for finger, _ in self._force_sum}
+        if self._quiet:  # (every drive stood still at its goal in this step: a cell at rest asks nothing here)
+            return out
         for finger, servos in self._servo_limits.items():
-            if finger not in pressed and any(abs(axes[name].velocity) > moving for name, _, moving in servos):
-                touching = self._touching(finger, within=0.0)
-                if touching:
-                    out[finger] = touching
+            for name, _, moving in servos:
+                speed = axes[name].velocity
+                if speed > moving or speed < -moving:
+                    break
+            else:  # (standing: reached nothing new)
+                continue
+            if any(pressed == finger for pressed, _ in self._force_sum):
+                continue
+            touching = self._touching(finger, within=0.0)
+            if touching:
+                out[finger] = touching
         return out
 
     def _touching(self, finger: str, slack: float = 0.0, within: float | None = None) -> tuple[str, ...]:
