@@ -441,19 +441,10 @@ def _status_settles(run: Run, spec: Spec):
 
 
 KNOWN = {
-    # (measure, gripper) -> what fails, as measured on main at 5b5d818 (fast fingers and late contact flags: fixed since)
-    ("force", "chuck"): "one-input 3-jaw chuck (mimics 1:1 and -1+0.06; the same with three 1:1 jaws): the jaws press "
-                        "40.6 / 28.3 / 20.7 N on the disc where virtual work gives 90 / 3 = 30 N each (sum 89.6 N)",
-    ("force", "bore"): "the same chuck opening into a 60 mm bore: 39.6 / 32.9 / 17.5 N where statics gives 30 N each",
-    ("force", "lever3"): "one-input 3-lever revolute chuck (two 1:1 mimics), 3 N m: the levers hold 1.37 / 0.87 / "
-                         "0.73 N m where virtual work gives 1 N m each",
-    ("penetration", "lever3"): "lever_1 (the input) stands 0.32 mm into the disc; were the followers where the URDF's "
-                               "mimic puts them (the master's angle), lever_2 and lever_3 would stand 1.05 and 1.67 mm "
-                               "into it (the disc pushed 0.75 mm towards them); twin check reads 0.30 and 0.24 mm for "
-                               "them: the followers stand ~15-25 mrad behind the master, the mimic coupling yields (and "
-                               "this test's tip model reads ~0.27 mm deeper than pybullet's shapes: getClosestPoints "
-                               "has lever_1 0.04-0.06 mm into the disc)",
-    ("push", "lever3"): "the centred disc (equal gaps, one drive) is pushed 0.75 mm by the unequal levers (limit 0.5)",
+    # (measure, gripper) -> what fails. Measured failing on main at 5b5d818 and fixed since: fast fingers' status,
+    # stillness and push (their arrival), late contact flags (a moving finger's overlap flags it), and the one-input
+    # chucks' force split, penetration and push (a linkage's drive on each of its joints, its gears let go once every
+    # jaw presses)
 }
 
 
@@ -592,25 +583,12 @@ def _fails(report):
     return {(c["who"], c["measure"]) for c in report["checks"] if c["level"] == "FAIL"}
 
 
-@pytest.mark.parametrize("key", ["quad", "pivot_box", "pair_neg", "heavy", "feather", "sloppy"])
+@pytest.mark.parametrize("key", ["quad", "pivot_box", "pair_neg", "heavy", "feather", "sloppy", "chuck", "bore", "lever3"])
 def test_twin_check_passes_the_grippers_whose_measures_pass(key, tmp_path):
     proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
     assert proc.returncode == 0 and report["verdict"] == "PASS", proc.stdout[-3000:]
     if SPECS[key].lift:
         assert any(c["measure"] == "lift" and c["level"] == "PASS" for c in report["checks"]), proc.stdout[-2000:]
-
-
-@pytest.mark.parametrize("key", ["chuck", "bore", "lever3"])
-def test_twin_check_fails_the_mimic_chucks_as_statics_does(key, tmp_path):
-    proc, report = twin_check(GRIPPERS / SPECS[key].station, tmp_path)
-    assert proc.returncode == 1 and report["verdict"] == "FAIL"
-    # the jaws measured above off their virtual-work share by more than 10 % are the ones it fails on force, and
-    # what else it fails is what was measured failing above (the levers' flicker and push)
-    spec, run = SPECS[key], measured(key)
-    off = {(f, "force") for f in spec.fingers if abs(run.force[f][1] - spec.force[f]) > 0.1 * spec.force[f]}
-    also = {"lever3": {(f, "status") for f in spec.fingers} | {("lever_1", "moving"), ("grip", "push")},
-            }.get(key, set())
-    assert off and off <= _fails(report) <= off | also, proc.stdout[-3000:]
 
 
 def test_twin_check_passes_four_independent_fingers_opening_into_a_bore(tmp_path):

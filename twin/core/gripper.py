@@ -90,7 +90,14 @@ RESTING_DRIFT = 2.0  # resting drives (`_still_resting`) rest on while each join
 # error a quiet drive's holding force allows of its command (at most half its in-position tolerance); past it (a push,
 # a load the holding force gives way to) the loop takes over again
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
-MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage)
+MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage) ...
+MIMIC_SETTLED_FACTOR = 0.005  # ... and this once every finger of a linkage of parallel jaws (each on a joint of its
+# own: a chuck's, a parallel gripper's) presses on a part: each joint's own motor takes its share of the drive's force
+# (`_linkage`) and the gears only keep the jaws in step. Rigid, they carry friction's indeterminate share between the
+# jaws: a one-input chuck's three jaws pressed 24 / 35 / 30 N of 90 N on a disc (41 / 28 / 21 N with the whole drive
+# on the master), 28.9 / 30.3 / 30.3 N with this (let go entirely, a 1:-1 scissor's levers on a free peg walk it, as
+# two drives pressing alone would). Rigid while any finger is free: a jaw that meets an off-centre part first pushes
+# it with the whole drive (a self-centring chuck centres its part), and the jaws run in step
 GRIP_FORCE_FRACTION = 0.1  # default grip_force: this share of the finger's drive effort
 LOST_WATCH_STEPS = 25  # a gripped part no finger presses on any more, and that no setpoint let go, is watched for
 # slip this many steps more (0.3 s at 12 ms): a dropped part leaves the fingers within a step
@@ -257,8 +264,21 @@ class Gripper:
         self._series_share = {p: dict(ss) for p, ss in self._series_loads.items()}
         self._holding: set[str] = set()  # series drives holding their goals rigidly against one pressing through them
         self._index = {name: i for i, name in enumerate(self.names)}
+        self._gears: dict[str, list[tuple[int, float]]] = {}  # per master input: its gear constraints
+        self._settled_linkages: dict[str, bool] = {}  # per master input: every finger of its linkage presses
         for joint, master, mult, off in self.mimics:
             self._couple(joint, master, mult, off)
+        # a linkage's drive acts on each of its joints (its master's and its mimics'), each with the drive's force
+        # over the sum of the multipliers' sizes: by virtual work the linkage then presses as the drive does (sum |m|
+        # f = F), and every joint alike, as a part held between its fingers needs in statics, without the gear
+        # constraints carrying the difference (through them alone, friction held a one-input chuck's three jaws at
+        # 41 / 28 / 21 N of 90 N)
+        self._linkage = []  # (master's input index, follower joint, multiplier, offset, share of the drive's force)
+        denominators = {name: 1.0 + sum(abs(mult) for _, m, mult, _ in self.mimics if m == name) for name in self.names}
+        for joint, master, mult, off in self.mimics:
+            self._linkage.append((self._index[master], joint, mult, off, 1.0 / denominators[master]))
+        self._master_share = [1.0 / denominators[name] for name in self.names]
+        self._motor_ids = self._joint_ids + [joint for _, joint, _, _, _ in self._linkage]
         self._mesh_links: set[int] = set()
         for links in self.finger_links.values():
             for link in links:
@@ -563,8 +583,8 @@ class Gripper:
                 c.resetJointState(self.body, joint, mult * q + off)
 
     def _couple(self, joint: int, master: str, mult: float, off: float) -> None:
-        """Tie a mimic joint to its master as a mechanism does (a gear constraint: joint = mult * master + off),
-        with no motor of its own: the master's drive moves the whole linkage, and a part pushing one coupled
+        """Tie a mimic joint to its master as a mechanism does (a gear constraint: joint = mult * master + off): the
+        master's drive moves the whole linkage (its motors on every joint, `_linkage`), and a part pushing one coupled
         finger pushes them all (a self-centring chuck centres its part)."""
         c = self.client
         c.setJointMotorControl2(self.body, joint, pybullet.VELOCITY_CONTROL, targetVelocity=0.0, force=0.0)
@@ -573,6 +593,21 @@ class Gripper:
         # the constraint holds q_joint + gearRatio * q_master = relativePositionTarget
         c.changeConstraint(gear, gearRatio=-mult, relativePositionTarget=off, erp=MIMIC_ERP,
                            maxForce=MIMIC_FORCE_FACTOR * self.drives[master].effort * max(1.0, abs(mult)))
+        jaws = set(self.finger_joint.values())
+        if self.joint[master] in jaws and all(j in jaws for j, m, _, _ in self.mimics if m == master):
+            self._gears.setdefault(master, []).append((gear, mult))  # (parallel jaws: let go once all press)
+
+    def _settle_linkages(self, pressed: set[str]) -> None:
+        """Each linkage of parallel jaws: its gears rigid while any of its fingers is free, let go (MIMIC_SETTLED_FACTOR)
+        once every one presses on a part. (A linkage whose joints lie in series, as a finger's knuckles do, stays
+        rigid: its gears carry the finger.)"""
+        for master, gears in self._gears.items():
+            settled = all(f in pressed for f in self._fingers_of_servo[master])
+            if settled != self._settled_linkages.get(master, False):
+                self._settled_linkages[master] = settled
+                factor = MIMIC_SETTLED_FACTOR if settled else MIMIC_FORCE_FACTOR
+                for gear, mult in gears:
+                    self.client.changeConstraint(gear, maxForce=factor * self.drives[master].effort * max(1.0, abs(mult)))
 
     # -- every substep ------------------------------------------------------------------------------------
     def _reset_sums(self) -> None:
@@ -752,8 +787,11 @@ class Gripper:
             # quiet for a second step: the drives rest (`_still_resting`), each held where its command stands by
             # pybullet's own position motor, taking out a substeps-th of its error at each substep (what the
             # loop asks of a quiet drive), with the force the loop gives it
-            self._motors(self.body, self._joint_ids, pybullet.POSITION_CONTROL,
-                         targetPositions=[command[name] for name in self.names], targetVelocities=[0.0] * len(forces),
+            positions = [command[name] for name in self.names]
+            if self._linkage:
+                positions, forces = self._linkage_command(positions, forces, True)
+            self._motors(self.body, self._motor_ids, pybullet.POSITION_CONTROL,
+                         targetPositions=positions, targetVelocities=[0.0] * len(forces),
                          forces=forces, positionGains=[1.0 / self.substeps] * len(forces),
                          velocityGains=[1.0] * len(forces))
             self._sent = None  # (the loop's next command is sent whatever it is)
@@ -772,9 +810,19 @@ class Gripper:
         self._holding = now_holding
         sent = (velocities, forces)
         if sent != self._sent:  # pybullet keeps a motor's command: the same one needs no call
-            self._motors(self.body, self._joint_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
-                         forces=forces)
             self._sent = sent
+            if self._linkage:
+                velocities, forces = self._linkage_command(velocities, forces, False)
+            self._motors(self.body, self._motor_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
+                         forces=forces)
+
+    def _linkage_command(self, values: list[float], forces: list[float], positions: bool) -> tuple[list, list]:
+        """The inputs' motor command (velocities, or positions) and forces, spread over their linkages' joints: each
+        follower moves as its multiplier says, and takes its share of its master's force (`_linkage`)."""
+        values = values + [mult * values[i] + (off if positions else 0.0) for i, _, mult, off, _ in self._linkage]
+        forces = ([f * share for f, share in zip(forces, self._master_share)]
+                  + [forces[i] * share for i, _, _, _, share in self._linkage])
+        return values, forces
 
     def _still_resting(self) -> bool:
         """Whether resting drives rest on: each holds where its command stands (pybullet's position motor, with the
@@ -881,7 +929,10 @@ class Gripper:
             elapsed = self._ticks * self.h
             self._speeds = [(s[0] - b[0]) / elapsed for s, b in zip(states, before)]
         self._ticks = 0
-        self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
+        if self._linkage:  # (a master's motor applies its share of the drive's force: the drive's, as the linkage's)
+            self._effort_sum = [e + s[3] / k for e, s, k in zip(self._effort_sum, states, self._master_share)]
+        else:
+            self._effort_sum = [e + s[3] for e, s in zip(self._effort_sum, states)]
         if not last:  # the contacts' forces: as the step's last substep leaves them (one query a step, not one a
             return  # substep: a held part's dozen contact points cost a quarter of the twin's own work in motion)
         sums, key_of = self._force_sum, self._link_keys.get
@@ -955,6 +1006,8 @@ class Gripper:
                                       for f, status in zip(self.finger_links, statuses)}
                 self._idle_statuses = statuses
             self._presses, self.pressing = self._pressing_none, False
+            if self._gears:
+                self._settle_linkages(set())
             self._n, self._effort_sum = 0, [0.0] * len(self.names)  # (the force sums are empty)
             if self._grip_reference is None:  # no finger touches: nothing is gripped, and no part is watched for slip
                 self.state.gripped = ""
@@ -983,6 +1036,8 @@ class Gripper:
         self.state.fingers = fingers
         pressed = {f for f, state in fingers.items() if state.force > 0.0}
         self._presses = {name: not pressed.isdisjoint(fs) for name, fs in self._fingers_of_servo.items()}
+        if self._gears:
+            self._settle_linkages(pressed)
         self.pressing = bool(pressed)  # a finger pressed on a part in this step
         self._reset_sums()
         self._grip_rule()
