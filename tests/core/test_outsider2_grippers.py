@@ -421,13 +421,17 @@ SPECS["quad_off"] = replace(SPECS["quad"], station="o2_quad_25n_off", centred=Fa
 # a 20 ms step (the station's `step`, 4 substeps): what a newcomer may choose for a slow cell
 SPECS["quad_20ms"] = replace(SPECS["quad"], edits=(("[station]\n", "[station]\nstep = 0.02\n"),))
 # fingers as fast as exported URDFs often say (0.5 m/s: 6 mm a step), set in the station
-def _fast(names):
-    return (("[[targets]]", "".join(f"[gripper.joints.{n}]\nvelocity = 0.5\n\n" for n in names) + "[[targets]]"),)
+def _fast(names, velocity=0.5):
+    return (("[[targets]]", "".join(f"[gripper.joints.{n}]\nvelocity = {velocity}\n\n" for n in names) + "[[targets]]"),)
 
 
 SPECS["quad_fast"] = replace(SPECS["quad"], edits=_fast(QUAD))
 SPECS["feather_fast"] = replace(SPECS["feather"], edits=_fast(("tip_a", "tip_b")))
 SPECS["heavy_fast"] = replace(SPECS["heavy"], edits=_fast(("jaw_a", "jaw_b")))
+# ... and fast revolute levers (3 rad/s: 0.8 mm a substep at their tips), a fast one-input chuck, a fast 20 ms step
+SPECS["pivot_box_fast"] = replace(SPECS["pivot_box"], edits=_fast(("lever_l", "lever_r"), 3.0))
+SPECS["chuck_fast"] = replace(SPECS["chuck"], edits=_fast(("f1",), 0.4))
+SPECS["quad_20ms_fast"] = replace(SPECS["quad"], edits=SPECS["quad_20ms"].edits + _fast(QUAD))
 ALL = list(SPECS)
 
 
