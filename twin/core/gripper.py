@@ -653,14 +653,20 @@ class Gripper:
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
             short = False  # a drive in one of the states a cell stands in, which the loop below gives in short
-            if pressing and not in_loads and not in_series and name not in turned:
-                # pressing on a part alone (no drives in series), with no new goal: its command at its goal (a setpoint
-                # within full force past the part), or stalled short of it on a part that holds: the command stays,
-                # and so does its stall (its way)
+            if pressing and not in_series and name not in turned:
+                # pressing on a part, with no new goal: its command at its goal (a setpoint within full force past the
+                # part; pressing through drives in series, while those its force loads stand at theirs: the ring rig's
+                # carriage and fine axis carrying the ring), or, alone, stalled short of it on a part that holds: the
+                # command stays, and so does its stall (its way)
                 way = stalled.get(name)
                 if way is None:
                     short = before == g and (in_holders or actual - full <= g <= actual + full)
-                else:
+                    if short and in_loads and in_holders and not rigid:
+                        for other, _ in loads[name]:
+                            if command[other] != goal[other]:
+                                short = False  # (the loop below asks whether it must hold rigidly against the other)
+                                break
+                elif not in_loads:
                     pushed = (before - actual) * way  # how far its command stands past the joint, the way it presses
                     short = ((g - before) * way > 0.0 and pushed > release and pushed >= follow
                              and actual - full <= before <= actual + full)
