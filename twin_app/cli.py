@@ -99,7 +99,7 @@ def _print_drives(target: str) -> None:
     try:
         with Twin.from_station(target) as twin:
             drives, notes = twin.gripper.drives, twin.world.inertia_notes + twin.gripper.effort_notes
-            unit = twin.gripper.unit
+            unit, derived = twin.gripper.unit, twin.gripper.derived_notes()
     finally:
         quiet.disabled = level
     rows = [("drive", "velocity", "effort", "stiffness", "damping", "full force at", "moves", "stable up to")]
@@ -116,6 +116,8 @@ def _print_drives(target: str) -> None:
         print("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
         if n == 0:
             print("  " + "  ".join("-" * w for w in widths))
+    for line in derived:
+        print(line)
     for note in notes:
         print(f"warning: {note}")
 

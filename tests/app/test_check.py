@@ -820,3 +820,23 @@ def test_a_ring_bench_with_two_springy_drives_in_series_on_a_finger_passes_its_c
     assert code == 0 and not lines(text, "FAIL"), text
     forces = {f["finger"]: f["force"] for f in grip(report, "ring", "outside")["fingers"]}
     assert forces == pytest.approx({"L2": 1500.0, "L3": 1500.0, "L5": 1500.0}, rel=0.02), text
+
+
+def test_twin_info_says_how_a_linkage_shares_its_drive_and_where_fast_fingers_slow_down(tmp_path):
+    # a one-input chuck of three 1:1 jaws on a 90 N drive: each joint's motor 90 / 3 = 30 N (virtual work); fingers
+    # at 0.5 m/s move 1.5 mm in a 3 ms substep, more than the 0.3 mm they may reach a part at
+    import shutil
+    import subprocess
+    import sys
+    from tests.grippers import HERE
+    out = subprocess.run([sys.executable, "-m", "twin_app.cli", "info", str(HERE / "o2_chuck3_mimic")],
+                         capture_output=True, text=True, check=True).stdout
+    assert "linkage: f1 drives slide_1, slide_2, slide_3, each joint's motor with 30 N" in out, out
+    station = tmp_path / "fast"
+    shutil.copytree(HERE / "o2_quad_25n", station)
+    toml = station / "station.toml"
+    toml.write_text(toml.read_text().replace("[[targets]]", "[gripper.joints.f_px]\nvelocity = 0.5\n\n[[targets]]", 1))
+    out = subprocess.run([sys.executable, "-m", "twin_app.cli", "info", str(station)],
+                         capture_output=True, text=True, check=True).stdout
+    assert "arrival: f_px's fingers move up to 0.5 m/s (1.5 mm a substep)" in out, out
+    assert "arrival: f_py" not in out, out  # (0.05 m/s: 0.15 mm a substep, nothing to slow down for)

@@ -598,16 +598,17 @@ class Gripper:
             self._gears.setdefault(master, []).append((gear, mult))  # (parallel jaws: let go once all press)
 
     def _settle_linkages(self, pressed: set[str]) -> None:
-        """Each linkage of parallel jaws: its gears rigid while any of its fingers is free, let go (MIMIC_SETTLED_FACTOR)
-        once every one presses on a part. (A linkage whose joints lie in series, as a finger's knuckles do, stays
-        rigid: its gears carry the finger.)"""
+        """Each linkage of parallel jaws: its gears rigid while any of its fingers is free, let go
+        (MIMIC_SETTLED_FACTOR) once every one presses on a part. (A linkage whose joints lie in series, as a finger's
+        knuckles do, stays rigid: its gears carry the finger.)"""
         for master, gears in self._gears.items():
             settled = all(f in pressed for f in self._fingers_of_servo[master])
             if settled != self._settled_linkages.get(master, False):
                 self._settled_linkages[master] = settled
                 factor = MIMIC_SETTLED_FACTOR if settled else MIMIC_FORCE_FACTOR
+                effort = self.drives[master].effort
                 for gear, mult in gears:
-                    self.client.changeConstraint(gear, maxForce=factor * self.drives[master].effort * max(1.0, abs(mult)))
+                    self.client.changeConstraint(gear, maxForce=factor * effort * max(1.0, abs(mult)))
 
     # -- every substep ------------------------------------------------------------------------------------
     def _reset_sums(self) -> None:
@@ -647,8 +648,8 @@ class Gripper:
         holding, now_holding = self._holding, set()  # series drives holding rigidly, as the last substep left them
         index, series_share = self._index, self._series_share
         for (name, moving, full, velocity, effort, held_speed, rise_rate, release, latch, follow, at_limit, in_loads,
-             in_holders, in_series, own_share, rigid, stiffness, damping, hold, arrival), (actual, joint_speed, _, _), moved in zip(
-                constants, states, self._speeds):
+             in_holders, in_series, own_share, rigid, stiffness, damping, hold, arrival), (actual, joint_speed, _, _), \
+                moved in zip(constants, states, self._speeds):
             g = goal[name]
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
@@ -854,6 +855,30 @@ class Gripper:
                         d.own / d.mass if d.mass else 0.0, d.rigid, d.stiffness, d.damping, d.hold,
                         self._arrival_constants(name, d)))
         return out
+
+    def derived_notes(self) -> list[str]:
+        """What the drives do beyond their gains, one line each (`twin info`): how a linkage's drive shares its force
+        among its joints, and where fast fingers slow down for a part."""
+        lines = []
+        names = {j: self.client.getJointInfo(self.body, j)[1].decode() for j in self._motor_ids}
+        for i, name in enumerate(self.names):
+            followers = [joint for master, joint, _, _, _ in self._linkage if master == i]
+            if followers:
+                d, share = self.drives[name], self._master_share[i]
+                unit = "N" if self.unit[name] == "m" else "N m"
+                joints = ", ".join(names[j] for j in [self.joint[name]] + followers)
+                lines.append(f"linkage: {name} drives {joints}, each joint's motor with {d.effort * share:.4g} "
+                             f"{unit} ({d.effort:g} {unit} over the sum of the multipliers' sizes, {1.0 / share:g}); "
+                             "its gears " + ("let go once every jaw presses" if name in self._gears else "stay rigid"))
+        for name, d in self.drives.items():
+            arrival = self._arrival_constants(name, d)
+            if arrival is not None:
+                _, rate, _, sight = arrival
+                fastest = d.velocity * rate
+                lines.append(f"arrival: {name}'s fingers move up to {fastest:.3g} m/s ({fastest * self.h * 1000:.3g} mm "
+                             f"a substep); nearing a target, within {(sight - fastest * self.h) * 1000:.3g} mm, they "
+                             f"slow down to reach it at {ARRIVAL_TRAVEL * 1000:g} mm a substep at most")
+        return lines
 
     def _arrival_constants(self, name: str, d: Drive) -> tuple | None:
         """For a drive whose fingers may move further than ARRIVAL_TRAVEL in a substep: its finger links, their
