@@ -823,8 +823,8 @@ def test_a_ring_bench_with_two_springy_drives_in_series_on_a_finger_passes_its_c
 
 
 def test_twin_info_says_how_a_linkage_shares_its_drive_and_where_fast_fingers_slow_down(tmp_path):
-    # a one-input chuck of three 1:1 jaws on a 90 N drive: each joint's motor 90 / 3 = 30 N (virtual work); fingers
-    # at 0.5 m/s move 1.5 mm in a 3 ms substep, more than the 0.3 mm they may reach a part at
+    # a one-input chuck of three jaws on a 90 N drive (mimics x1 and x-1): each joint's motor 90 / (1 + 1 + 1) = 30 N
+    # (virtual work); fingers at 0.5 m/s move 1.5 mm in a 3 ms substep, more than the 0.3 mm they may reach a part at
     import shutil
     import subprocess
     import sys
@@ -840,3 +840,4 @@ def test_twin_info_says_how_a_linkage_shares_its_drive_and_where_fast_fingers_sl
                          capture_output=True, text=True, check=True).stdout
     assert "arrival: f_px's fingers move up to 0.5 m/s (1.5 mm a substep)" in out, out
     assert "arrival: f_py" not in out, out  # (0.05 m/s: 0.15 mm a substep, nothing to slow down for)
+    assert "arrival: lift" not in out, out  # (0.1 m/s: 0.3 mm a substep, at most what a finger may arrive at)

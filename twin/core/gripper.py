@@ -295,7 +295,9 @@ class Gripper:
                            for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
         self._quiet = False
         self._resting: tuple | None = None  # (Active, per input the joint's bounds) while the drives rest
-        self._gaps: dict[str, float] = {}  # per fast drive: its fingers' gap to the nearest target, last substep
+        self._gaps: dict[str, tuple[int, float]] = {}  # per fast drive: (substep, its fingers' gap to the nearest
+        # target then), as it last looked
+        self._substep_count = 0  # physics substeps driven or coasted since the start
         # the joints' states as last read (after the last physics substep: what the next drive starts from), and
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
         self._states = None
@@ -385,12 +387,16 @@ class Gripper:
         part = min((m for m in masses if m > 0), default=0.0)
         finger_links = set(self._finger_of_link)
         moved = {}
+        self._link_mover: dict[str, dict[int, tuple[int, float]]] = {}  # per drive: link -> (joint moving it, mult)
         for name in self.names:
             links = [(k, 1.0) for k in subtree(self.joint[name])]
+            movers = {k: (self.joint[name], 1.0) for k in subtree(self.joint[name])}
             for joint, master, mult, _ in self.mimics:
                 if master == name:
                     links += [(k, mult) for k in subtree(joint)]
+                    movers.update({k: (joint, mult) for k in subtree(joint)})
             moved[name] = links
+            self._link_mover[name] = movers
         carriers = {name for name in self.names if finger_links & {k for k, _ in moved[name]}}
         share = max(1, len({servos[0] for servos in self.finger_servos.values() if servos}))  # the fingers' own drives
         self.finger_forces: dict[str, float] = {}  # N: what each finger-carrying drive presses a finger with, at most
@@ -623,6 +629,7 @@ class Gripper:
         substep before (nothing moves the joints in between)."""
         self._step_ticks += 1
         self._ticks += 1
+        self._substep_count += 1
         if substep and self._quiet:
             return
         if self._resting is not None:
@@ -899,20 +906,40 @@ class Gripper:
         substep landing ARRIVAL_DEPTH into the part. Moving away from a part, they are not slowed."""
         links, rate, braking, sight = arrival
         c, body, near, h = self.client, self.body, self._target_by_id, self.h
-        gap = sight
+        gap, nearest = sight, None
         for link in links:
             lo, hi = c.getAABB(body, link)
             found = c.getOverlappingObjects([x - sight for x in lo], [x + sight for x in hi]) or ()
             for uid in {uid for uid, _ in found if uid in near}:
                 for pt in c.getClosestPoints(body, uid, sight, linkIndexA=link):
-                    gap = min(gap, pt[8])
-        last, self._gaps[name] = self._gaps.get(name), gap
+                    if pt[8] < gap:
+                        gap, nearest = pt[8], pt
+        seen = self._gaps.get(name)  # (the gap the substep before, if it looked)
+        last = seen[1] if seen is not None and seen[0] == self._substep_count - 1 else None
+        self._gaps[name] = (self._substep_count, gap)
         if gap >= sight or (last is not None and gap > last):
-            return speed
+            return speed  # (out of sight, or moving away)
+        if (last is None or gap == last) and not self._moves_towards(name, nearest, speed):
+            return speed  # (setting off from beside a part, away from it)
         gap = max(gap, 0.0)
         final = min(ARRIVAL_TRAVEL, gap + ARRIVAL_DEPTH) / h
         cap = min(max(gap / (2.0 * h), final), final + math.sqrt(braking * gap)) / rate
         return speed if abs(speed) <= cap else (cap if speed > 0.0 else -cap)
+
+    def _moves_towards(self, name: str, point, speed: float) -> bool:
+        """Whether input `name` running at `speed` moves the finger link of closest point `point` (a pybullet
+        closest-points row) towards the part there: against the normal on the part, by the joint that moves that link
+        (a mimic's with its multiplier), along its axis (prismatic) or about it (revolute)."""
+        joint, mult = self._link_mover[name][point[3]]
+        info = self.client.getJointInfo(self.body, joint)
+        state = self.client.getLinkState(self.body, joint)
+        axis = _rotate(state[5], info[13])  # the joint's axis in the world (its child link's frame is the joint's)
+        if info[2] == pybullet.JOINT_PRISMATIC:
+            motion = axis
+        else:  # the contact point's motion about the axis: axis x (point - origin)
+            r = [point[5][i] - state[4][i] for i in range(3)]
+            motion = (axis[1] * r[2] - axis[2] * r[1], axis[2] * r[0] - axis[0] * r[2], axis[0] * r[1] - axis[1] * r[0])
+        return sum(motion[i] * point[7][i] for i in range(3)) * mult * speed < 0.0
 
     def read_along(self, joints: list[int]) -> None:
         """Read `joints` (of the same body) with the inputs' joints after each step's last substep, into `along`
@@ -926,6 +953,7 @@ class Gripper:
         substep's settings and nothing is measured before the last (`drive` and `measure` would do nothing else)."""
         self._step_ticks += substeps
         self._ticks += substeps
+        self._substep_count += substeps
 
     @property
     def step_positions(self) -> list[float] | None:
