@@ -182,6 +182,7 @@ class Gripper:
                  mechanism: Mechanism, spec: GripperSpec, targets: dict[str, int], substep: float,
                  contact_probe=None, substeps: int = 1):
         self.client, self.body, self.mechanism, self.spec = client, body, mechanism, spec
+        self._joint_kinds: dict[int, tuple[int, tuple]] = {}  # joint -> (its type, its axis in its frame), as read
         self.targets = targets  # target name -> body id, in station order
         self._target_by_id = {uid: name for name, uid in targets.items()}
         self.base_link = link_index[mechanism.base_link]
@@ -264,21 +265,23 @@ class Gripper:
         self._series_share = {p: dict(ss) for p, ss in self._series_loads.items()}
         self._holding: set[str] = set()  # series drives holding their goals rigidly against one pressing through them
         self._index = {name: i for i, name in enumerate(self.names)}
-        self._gears: dict[str, list[tuple[int, float]]] = {}  # per master input: its gear constraints
         self._settled_linkages: dict[str, bool] = {}  # per master input: every finger of its linkage presses
-        for joint, master, mult, off in self.mimics:
-            self._couple(joint, master, mult, off)
+        gears = [(master, self._couple(joint, master, mult, off), mult) for joint, master, mult, off in self.mimics]
+        jaws = set(self.finger_joint.values())  # parallel jaws: every joint of the linkage a finger's own
+        self._gears: dict[str, list[tuple[int, float]]] = {}  # per linkage of parallel jaws (its master): its gears
+        for master, gear, mult in gears:
+            if self.joint[master] in jaws and all(j in jaws for j, m, _, _ in self.mimics if m == master):
+                self._gears.setdefault(master, []).append((gear, mult))
         # a linkage's drive acts on each of its joints (its master's and its mimics'), each with the drive's force
         # over the sum of the multipliers' sizes: by virtual work the linkage then presses as the drive does (sum |m|
         # f = F), and every joint alike, as a part held between its fingers needs in statics, without the gear
         # constraints carrying the difference (through them alone, friction held a one-input chuck's three jaws at
         # 41 / 28 / 21 N of 90 N)
-        self._linkage = []  # (master's input index, follower joint, multiplier, offset, share of the drive's force)
-        denominators = {name: 1.0 + sum(abs(mult) for _, m, mult, _ in self.mimics if m == name) for name in self.names}
-        for joint, master, mult, off in self.mimics:
-            self._linkage.append((self._index[master], joint, mult, off, 1.0 / denominators[master]))
-        self._master_share = [1.0 / denominators[name] for name in self.names]
-        self._motor_ids = self._joint_ids + [joint for _, joint, _, _, _ in self._linkage]
+        self._linkage = [(self._index[master], joint, mult, off) for joint, master, mult, off in self.mimics]
+        # (per follower: its master's input index, its joint, multiplier and offset)
+        self._master_share = [1.0 / (1.0 + sum(abs(mult) for _, m, mult, _ in self.mimics if m == name))
+                              for name in self.names]  # each joint's share of its drive's force
+        self._motor_ids = self._joint_ids + [joint for _, joint, _, _ in self._linkage]
         self._mesh_links: set[int] = set()
         for links in self.finger_links.values():
             for link in links:
@@ -313,7 +316,6 @@ class Gripper:
                                   for name in servos] for f, servos in self.finger_servos.items()}
         self.read_along([])
         self._idle_statuses: list[int] | None = None  # the fingers' statuses while their states are of touching nothing
-        self._joint_axis = {f: client.getJointInfo(body, j)[13] for f, j in self.finger_joint.items()}
         self._joint_frames: dict[str, tuple] = {}  # revolute fingers' joint frames, this substep
         self.state = GripState()
         self._reset_sums()
@@ -389,13 +391,11 @@ class Gripper:
         moved = {}
         self._link_mover: dict[str, dict[int, tuple[int, float]]] = {}  # per drive: link -> (joint moving it, mult)
         for name in self.names:
-            links = [(k, 1.0) for k in subtree(self.joint[name])]
             movers = {k: (self.joint[name], 1.0) for k in subtree(self.joint[name])}
             for joint, master, mult, _ in self.mimics:
                 if master == name:
-                    links += [(k, mult) for k in subtree(joint)]
                     movers.update({k: (joint, mult) for k in subtree(joint)})
-            moved[name] = links
+            moved[name] = [(k, mult) for k, (_, mult) in movers.items()]
             self._link_mover[name] = movers
         carriers = {name for name in self.names if finger_links & {k for k, _ in moved[name]}}
         share = max(1, len({servos[0] for servos in self.finger_servos.values() if servos}))  # the fingers' own drives
@@ -406,21 +406,20 @@ class Gripper:
         for name in self.names:
             d, links = self.drives[name], moved[name]
             fingers = name in carriers
-            jaws = sum(abs(m) for k, m in links if k in finger_links) or 1.0  # a linkage shares its effort out
+            pads = [(k, m) for k, m in links if k in finger_links]  # the finger links it moves
+            jaws = sum(abs(m) for _, m in pads) or 1.0  # a linkage shares its effort out
             if self.unit[name] == "m":
                 own = sum(mult * mult * c.getDynamicsInfo(body, k)[0] for k, mult in links)
                 mass, floor = own + (part if fingers else 0.0), 1e-3
                 if fingers:
                     self.finger_forces[name] = d.effort / jaws
-                    self._finger_travel[name] = ([k for k, _ in links if k in finger_links],
-                                                 max(abs(m) for k, m in links if k in finger_links))
+                    self._finger_travel[name] = ([k for k, _ in pads], max(abs(m) for _, m in pads))
             else:
                 own, reach = self._inertia_about_axis(name, links, finger_links)
-                if fingers and reach > 0.0:
-                    self._finger_travel[name] = ([k for k, _ in links if k in finger_links], reach)
                 mass, floor = own + (part * reach * reach if fingers else 0.0), 1e-7
                 if fingers and reach > 0.0:
                     self.finger_forces[name] = d.effort / reach / jaws  # at the fingers' reach
+                    self._finger_travel[name] = ([k for k, _ in pads], reach)
             mass, own = max(mass, floor), max(own, floor)
             limit = STIFFNESS_SHARE * mass / (share * h * h)
             stiffness = stiffness_given[name] or min(d.effort / FULL_FORCE_ERROR[self.unit[name]], limit)
@@ -468,8 +467,7 @@ class Gripper:
         fingers: the farthest corner of their bounding boxes from the axis."""
         c, body = self.client, self.body
         j = self.joint[name]
-        state = c.getLinkState(body, j, computeForwardKinematics=True)
-        origin, axis = state[4], _rotate(state[5], c.getJointInfo(body, j)[13])
+        origin, axis = self._joint_frame(j, kinematics=True)
 
         def off_axis(p) -> float:
             r = [p[i] - origin[i] for i in range(3)]
@@ -588,7 +586,7 @@ class Gripper:
             if master == name:
                 c.resetJointState(self.body, joint, mult * q + off)
 
-    def _couple(self, joint: int, master: str, mult: float, off: float) -> None:
+    def _couple(self, joint: int, master: str, mult: float, off: float) -> int:
         """Tie a mimic joint to its master as a mechanism does (a gear constraint: joint = mult * master + off): the
         master's drive moves the whole linkage (its motors on every joint, `_linkage`), and a part pushing one coupled
         finger pushes them all (a self-centring chuck centres its part)."""
@@ -599,9 +597,7 @@ class Gripper:
         # the constraint holds q_joint + gearRatio * q_master = relativePositionTarget
         c.changeConstraint(gear, gearRatio=-mult, relativePositionTarget=off, erp=MIMIC_ERP,
                            maxForce=MIMIC_FORCE_FACTOR * self.drives[master].effort * max(1.0, abs(mult)))
-        jaws = set(self.finger_joint.values())
-        if self.joint[master] in jaws and all(j in jaws for j, m, _, _ in self.mimics if m == master):
-            self._gears.setdefault(master, []).append((gear, mult))  # (parallel jaws: let go once all press)
+        return gear
 
     def _settle_linkages(self, pressed: set[str]) -> None:
         """Each linkage of parallel jaws: its gears rigid while any of its fingers is free, let go
@@ -833,10 +829,9 @@ class Gripper:
     def _linkage_command(self, values: list[float], forces: list[float], positions: bool) -> tuple[list, list]:
         """The inputs' motor command (velocities, or positions) and forces, spread over their linkages' joints: each
         follower moves as its multiplier says, and takes its share of its master's force (`_linkage`)."""
-        values = values + [mult * values[i] + (off if positions else 0.0) for i, _, mult, off, _ in self._linkage]
-        forces = ([f * share for f, share in zip(forces, self._master_share)]
-                  + [forces[i] * share for i, _, _, _, share in self._linkage])
-        return values, forces
+        values = values + [mult * values[i] + (off if positions else 0.0) for i, _, mult, off in self._linkage]
+        shared = [f * share for f, share in zip(forces, self._master_share)]
+        return values, shared + [shared[i] for i, _, _, _ in self._linkage]
 
     def _still_resting(self) -> bool:
         """Whether resting drives rest on: each holds where its command stands (pybullet's position motor, with the
@@ -867,13 +862,12 @@ class Gripper:
         """What the drives do beyond their gains, one line each (`twin info`): how a linkage's drive shares its force
         among its joints, and where fast fingers slow down for a part."""
         lines = []
-        names = {j: self.client.getJointInfo(self.body, j)[1].decode() for j in self._motor_ids}
         for i, name in enumerate(self.names):
-            followers = [joint for master, joint, _, _, _ in self._linkage if master == i]
+            followers = [m.joint for m in self.mechanism.mimics if m.master == self.mechanism.input(name).joint]
             if followers:
                 d, share = self.drives[name], self._master_share[i]
                 unit = "N" if self.unit[name] == "m" else "N m"
-                joints = ", ".join(names[j] for j in [self.joint[name]] + followers)
+                joints = ", ".join([self.mechanism.input(name).joint] + followers)
                 lines.append(f"linkage: {name} drives {joints}, each joint's motor with {d.effort * share:.4g} "
                              f"{unit} ({d.effort:g} {unit} over the sum of the multipliers' sizes, {1.0 / share:g}); "
                              "its gears " + ("let go once every jaw presses" if name in self._gears else "stay rigid"))
@@ -905,12 +899,10 @@ class Gripper:
         sqrt(a gap)) until that is slower than ARRIVAL_TRAVEL a substep; then they move on at that, the last
         substep landing ARRIVAL_DEPTH into the part. Moving away from a part, they are not slowed."""
         links, rate, braking, sight = arrival
-        c, body, near, h = self.client, self.body, self._target_by_id, self.h
+        c, body, h = self.client, self.body, self.h
         gap, nearest = sight, None
         for link in links:
-            lo, hi = c.getAABB(body, link)
-            found = c.getOverlappingObjects([x - sight for x in lo], [x + sight for x in hi]) or ()
-            for uid in {uid for uid, _ in found if uid in near}:
+            for uid in self._targets_near(link, sight):
                 for pt in c.getClosestPoints(body, uid, sight, linkIndexA=link):
                     if pt[8] < gap:
                         gap, nearest = pt[8], pt
@@ -931,14 +923,11 @@ class Gripper:
         closest-points row) towards the part there: against the normal on the part, by the joint that moves that link
         (a mimic's with its multiplier), along its axis (prismatic) or about it (revolute)."""
         joint, mult = self._link_mover[name][point[3]]
-        info = self.client.getJointInfo(self.body, joint)
-        state = self.client.getLinkState(self.body, joint)
-        axis = _rotate(state[5], info[13])  # the joint's axis in the world (its child link's frame is the joint's)
-        if info[2] == pybullet.JOINT_PRISMATIC:
+        origin, axis = self._joint_frame(joint)
+        if self._joint_kind(joint)[0] == pybullet.JOINT_PRISMATIC:
             motion = axis
         else:  # the contact point's motion about the axis: axis x (point - origin)
-            r = [point[5][i] - state[4][i] for i in range(3)]
-            motion = (axis[1] * r[2] - axis[2] * r[1], axis[2] * r[0] - axis[0] * r[2], axis[0] * r[1] - axis[1] * r[0])
+            motion = _cross(axis, [point[5][i] - origin[i] for i in range(3)])
         return sum(motion[i] * point[7][i] for i in range(3)) * mult * speed < 0.0
 
     def read_along(self, joints: list[int]) -> None:
@@ -1013,17 +1002,29 @@ class Gripper:
     def _torque(self, finger: str, pt) -> float:
         """The torque about a revolute finger's joint axis of one contact's force (normal and friction) on the part."""
         frame = self._joint_frames.get(finger)
-        if frame is None:  # the joint's frame and axis in the world, read once per substep
-            link = self.client.getLinkState(self.body, self.finger_joint[finger])
-            origin = link[4]  # the child link's URDF frame: the joint's frame
-            frame = self._joint_frames[finger] = (origin, _rotate(link[5], self._joint_axis[finger]))
+        if frame is None:  # (read once per substep)
+            frame = self._joint_frames[finger] = self._joint_frame(self.finger_joint[finger])
         origin, axis = frame
         r = [pt[5][i] - origin[i] for i in range(3)]
         # the contact's whole force on B (the normal on B points at A, the finger: -n N; and its friction), as the
         # joint carries it in statics (the normal force alone reads 10 % short where friction carries a share)
         f = [-(pt[7][i] * pt[9] + pt[10] * pt[11][i] + pt[12] * pt[13][i]) for i in range(3)]
-        tau = (r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0])
+        tau = _cross(r, f)
         return sum(tau[i] * axis[i] for i in range(3))
+
+    def _joint_kind(self, joint: int) -> tuple[int, tuple]:
+        """A joint's type and its axis in its own frame (read from pybullet once)."""
+        kind = self._joint_kinds.get(joint)
+        if kind is None:
+            info = self.client.getJointInfo(self.body, joint)
+            kind = self._joint_kinds[joint] = (info[2], info[13])
+        return kind
+
+    def _joint_frame(self, joint: int, kinematics: bool = False) -> tuple[tuple, tuple]:
+        """A joint's origin and axis in the world, as the last physics substep left them (`kinematics`: computed
+        from the joints' positions, as before the first substep)."""
+        state = self.client.getLinkState(self.body, joint, computeForwardKinematics=kinematics)
+        return state[4], _rotate(state[5], self._joint_kind(joint)[1])  # (the child link's URDF frame: the joint's)
 
     # -- after each step --------------------------------------------------------------------------------------
     def sense(self) -> None:
@@ -1159,17 +1160,22 @@ class Gripper:
                 out[finger] = touching
         return out
 
+    def _targets_near(self, link: int, reach: float) -> list[int]:
+        """The targets (body ids, in order) whose bounding boxes come within `reach` of the link's: pybullet's
+        broadphase, before any exact query."""
+        lo, hi = self.client.getAABB(self.body, link)
+        found = self.client.getOverlappingObjects([v - reach for v in lo], [v + reach for v in hi]) or ()
+        return sorted({uid for uid, _ in found if uid in self._target_by_id})
+
     def _touching(self, finger: str, slack: float = 0.0, within: float | None = None) -> tuple[str, ...]:
         """Targets within contact_distance (+ slack; or `within`) of the finger's true shape (never before they
         touch)."""
         c, d = self.client, max(self.spec.contact_distance, slack) if within is None else within
         found: set[str] = set()
         for link in self.finger_links[finger]:
-            lo, hi = c.getAABB(self.body, link)
-            nearby = c.getOverlappingObjects([v - d - COLLISION_MARGIN for v in lo], [v + d + COLLISION_MARGIN for v in hi]) or ()
             limit = d - (HULL_MARGIN if link in self._mesh_links else 0.0)
             exact = self.probe is not None and self.probe.covers(link)
-            for uid in sorted({uid for uid, _ in nearby if uid in self._target_by_id}):
+            for uid in self._targets_near(link, d + COLLISION_MARGIN):
                 if exact:
                     gap = self.probe.distance(link, uid, d)
                     touching = gap is not None and gap <= d
@@ -1251,6 +1257,10 @@ class Gripper:
             self._release()
         if self._grip_reference is not None and self._grip_reference[0] == name:
             self._grip_reference = None
+
+
+def _cross(a, b) -> tuple[float, float, float]:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def _rotate(orn, v):

@@ -322,10 +322,7 @@ class Robot:
                 self._hold, self._hold_for = queue.q(queue.end), traj
             self._command_hold(self._hold)
         elif rate == 1.0:
-            q, qd = queue.command(tau)  # (lists of floats: `_command` without its conversions)
-            self._held = None
-            self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=q, targetVelocities=qd,
-                         forces=self.forces, positionGains=self._gains[0], velocityGains=self._gains[1])
+            self._send(*queue.command(tau))  # (lists of floats already: no conversion)
         else:  # StopMove / StartMove: on the path, at the clock's rate
             q, qd = queue.state(tau)
             self._command(q, qd * rate)
@@ -337,10 +334,13 @@ class Robot:
             self._held = q
 
     def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
+        self._send(_floats(q), _floats(qd))
+
+    def _send(self, q: list[float], qd: list[float]) -> None:
+        """The arm's position motors to q at qd (Python floats), with their forces and gains."""
         self._held = None
-        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=_floats(q),
-                     targetVelocities=_floats(qd), forces=self.forces, positionGains=self._gains[0],
-                     velocityGains=self._gains[1])
+        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=q, targetVelocities=qd,
+                     forces=self.forces, positionGains=self._gains[0], velocityGains=self._gains[1])
 
 
 def _floats(values) -> list[float]:
