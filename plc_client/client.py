@@ -645,7 +645,8 @@ class _ReadPlan:
         if last is None:
             todo = range(len(self.slots))
         else:
-            todo = sorted({i for readers in compress(self.readers, map(ne, now, last)) for i in readers})
+            todo = {i for readers in compress(self.readers, map(ne, now, last)) for i in readers}  # (any order:
+            # `values` already holds every name)
         values = dict(self.values)
         slots = self.slots
         for i in todo:

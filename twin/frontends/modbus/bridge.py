@@ -141,8 +141,10 @@ class TwinBridge:
         self._images = None
 
     def _show_written(self, batch: Sequence[tuple[str, object]]) -> None:
-        """An accepted write (of any front end): the coil and holding-register images show it from the next read."""
-        self._images = None
+        """An accepted write (of any front end), queued: the coil and holding-register images show it. Laid over
+        images already formed (the batches queued before it are in them), else formed with it at the next read."""
+        if self._images is not None:
+            self._images = self._written_over(self._images, batch)
 
     def _written_over(self, images: Images, batch: Sequence[tuple[str, object]]) -> Images:
         """`images` with a batch of writes in the coil and holding-register images."""
