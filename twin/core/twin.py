@@ -140,7 +140,7 @@ class Twin:
                 robot.update(t)
             world.stasis.before_physics(self._machine_still)  # a cell at rest has its loose bodies frozen: thawed
             world.substep_physics()  # before anything may move them
-            if gripper.quiet and (robot is None or robot.holding):
+            if gripper.coasting and (robot is None or robot.holding):
                 # nothing is commanded anew in the step's other substeps (the drives keep the first one's settings,
                 # the arm its hold), and nothing is measured until the last: the physics alone runs
                 gripper.coast(substeps - 1)
