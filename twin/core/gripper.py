@@ -89,6 +89,7 @@ HELD_SHARE = 0.5  # a joint that moved less than this share of its velocity limi
 RESTING_DRIFT = 2.0  # resting drives (`_still_resting`) rest on while each joint stays within this many times the
 # error a quiet drive's holding force allows of its command (at most half its in-position tolerance); past it (a push,
 # a load the holding force gives way to) the loop takes over again
+PIN_DRIFT = 0.5  # pinned drives stay pinned while each spring's force changes by at most this share of its hold
 PIN_PART_RATIO = 5.0  # drives pressing on a part this many times heavier than what each moves itself are pinned (`_pin`)
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage) ...
@@ -299,6 +300,7 @@ class Gripper:
                            for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
         self._quiet = False
         self._pinned = False  # the drives held by `_pin` for the rest of this step
+        self._pin_bounds: tuple | None = None  # (Active, the presses, per input the joint's bounds) while pinned
         self._steady = False  # every drive stalled or standing, unmoved, at the last step's first substep
         self._resting: tuple | None = None  # (Active, per input the joint's bounds) while the drives rest
         self._gaps: dict[str, tuple[int, float]] = {}  # per fast drive: (substep, its fingers' gap to the nearest
@@ -638,6 +640,11 @@ class Gripper:
             if self._still_resting():
                 return
             self._resting = None
+        if self._pin_bounds is not None:
+            if self._still_pinned():
+                self._pinned = True
+                return
+            self._pin_bounds = None
         if not self.active and self._hold is None:
             self._hold = dict(self.command_position)
         elif self.active:
@@ -812,7 +819,7 @@ class Gripper:
                      and stiffness * abs(error) <= hold)  # a pressing drive: every substep
         if substep == 0:
             if steady and not quiet and self._steady and self.substeps > 1:
-                self._pin(command, pin_forces, gains)
+                self._pin(command, pin_forces, gains, [s[0] for s in states])
                 self._quiet, self._holding = quiet, now_holding
                 return
             self._steady = steady and not quiet
@@ -849,13 +856,13 @@ class Gripper:
             self._motors(self.body, self._motor_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
                          forces=forces)
 
-    def _pin(self, command: dict[str, float], forces: list[float], gains: list[float]) -> None:
+    def _pin(self, command: dict[str, float], forces: list[float], gains: list[float], actual: list[float]) -> None:
         """Hold every drive for the rest of the step with pybullet's position motor: each at its command, taking out
         the share of its error a substep that the loop asked for (`gains`), with the loop's force. Done when every
         finger stalls on its part (or stands at its goal) for a second step: the loop would ask the same of them at
         each substep, a spring's force a hair different, but working it out and changing the motors' limits every
         substep costs the twin's Python a third more and the solver a quarter more in a carry. `sense` still decides
-        everything after each step, and the next step's first substep runs the loop again."""
+        everything after each step. The drives stay pinned while nothing changes (`_still_pinned`)."""
         positions = [command[name] for name in self.names]
         if self._linkage:
             positions, forces = self._linkage_command(positions, forces, True)
@@ -865,6 +872,19 @@ class Gripper:
                      velocityGains=[1.0] * len(forces))
         self._sent = None  # (the loop's next command is sent whatever it is)
         self._pinned = True
+        bounds = []
+        for (name, unit, _), q in zip(self._per_input, actual):
+            d = self.drives[name]
+            allowed = min(PIN_DRIFT * d.hold / d.stiffness if d.stiffness else 0.0, 0.5 * IN_POSITION_TOLERANCE[unit])
+            bounds.append((q - allowed, q + allowed))
+        self._pin_bounds = (self.active, dict(self._presses), bounds)
+
+    def _still_pinned(self) -> bool:
+        """Whether pinned drives stay pinned (`_pin`), as they were set: while no setpoint, limit or `Active` changes,
+        the same drives' fingers press on parts, and every joint stays within its bounds (`sense` looks): where its
+        spring's force has changed by at most PIN_DRIFT times its holding force."""
+        active, presses, _ = self._pin_bounds
+        return not (self._new_goal or self._constants is None or active != self.active or presses != self._presses)
 
     def _linkage_command(self, values: list[float], forces: list[float], positions: bool) -> tuple[list, list]:
         """The inputs' motor command (velocities, or positions) and forces, spread over their linkages' joints: each
@@ -1092,6 +1112,11 @@ class Gripper:
             for q, (lo, hi) in zip(positions, self._resting[1]):
                 if not lo <= q <= hi:
                     self._resting = None  # (the next step's loop takes the error out, and its command is sent)
+                    break
+        if self._pin_bounds is not None:  # pinned drives likewise
+            for q, (lo, hi) in zip(positions, self._pin_bounds[2]):
+                if not lo <= q <= hi:
+                    self._pin_bounds = None
                     break
         friction = self.spec.grip == "friction"
         reached = self._reached(axes) if friction else {}
