@@ -1,6 +1,7 @@
 """The robot in the physics world: drives an arm's joints along a trajectory, step by step.
 
-`Robot.update(t)` is called before every physics (sub)step from t to t + dt. It commands pybullet's
+`Robot.commands(t, n)` gives the commands for a step's n physics substeps, `send` sends each before its substep
+from t to t + dt (`update(t)`: one substep's, sent at once). Each commands pybullet's
 POSITION_CONTROL towards where the planned motion will be at the end of the step (`q(t + dt)`, with
 `qd(t + dt)` as the velocity feed-forward), with the axes' URDF efforts as force limits. The planned motion is
 a `MotionQueue` (planner.py): `start` replaces it with one motion, `queue` appends one that starts after the
@@ -107,7 +108,7 @@ class Robot:
         for j, v in zip(self.joints, q):
             self.client.resetJointState(self.body, j, float(v), 0.0)
         self._traj, self._queue, self._settled, self._hold, self.fault = None, None, True, q, None
-        self._command(q, np.zeros_like(q))
+        self.send(self._command(q, np.zeros_like(q)))
         self.check_kinematics()
 
     def check_kinematics(self, tolerance: float = 1e-4) -> None:
@@ -303,16 +304,32 @@ class Robot:
         return actual.distance(planned) <= self.settle_distance and actual.angle(planned) <= self.settle_angle
 
     def update(self, t: float) -> None:
-        """Command the arm for the step from t to t + dt (call once per step, before physics steps)."""
+        """Command the arm for the substep from t to t + dt (call once per substep, before it runs)."""
+        command = self._next(t)
+        if command is not None:
+            self.send(command)
+
+    def commands(self, t: float, n: int) -> list[tuple | None]:
+        """The arm's commands for the n substeps from t on, worked out at once (the same as `update` at each of them
+        would send: None where it would send nothing): the step sends each before its substep with `send`, and the
+        arm's Python runs once a step, not between substeps, where pybullet has just left the caches cold."""
+        return [self._next(t + k * self.dt) for k in range(n)]
+
+    def send(self, command: tuple) -> None:
+        """The arm's position motors to q at qd (`commands`' Python floats), with their forces and gains."""
+        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=command[0],
+                     targetVelocities=command[1], forces=self.forces, positionGains=self._gains[0],
+                     velocityGains=self._gains[1])
+
+    def _next(self, t: float) -> tuple | None:
+        """What `update(t)` sends: (q, qd) as lists of floats, or None (the hold is commanded already)."""
         traj = self._traj
         if self._paused is not None:
             if traj is not None and self._clock is not None:
                 self._clock.shift(self.dt)  # the motion's clock stands still
-            self._command(self._paused, np.zeros(len(self.joints)))
-            return
+            return self._command(self._paused, np.zeros(len(self.joints)))
         if traj is None:
-            self._command_hold(self._hold)
-            return
+            return self._command_hold(self._hold)
         if self._clock is None:
             self._clock = PathClock(t)
         tau, rate = self._clock.at(t + self.dt)
@@ -320,27 +337,24 @@ class Robot:
         if tau >= queue.end:
             if self._hold_for is not traj:
                 self._hold, self._hold_for = queue.q(queue.end), traj
-            self._command_hold(self._hold)
-        elif rate == 1.0:
-            self._send(*queue.command(tau))  # (lists of floats already: no conversion)
-        else:  # StopMove / StartMove: on the path, at the clock's rate
-            q, qd = queue.state(tau)
-            self._command(q, qd * rate)
-
-    def _command_hold(self, q: np.ndarray) -> None:
-        """Hold q: commanded once (the motors keep their command), not again at every substep."""
-        if self._held is not q:
-            self._command(q, np.zeros(len(self.joints)))
-            self._held = q
-
-    def _command(self, q: np.ndarray, qd: np.ndarray) -> None:
-        self._send(_floats(q), _floats(qd))
-
-    def _send(self, q: list[float], qd: list[float]) -> None:
-        """The arm's position motors to q at qd (Python floats), with their forces and gains."""
+            return self._command_hold(self._hold)
         self._held = None
-        self._motors(self.body, self.joints, pybullet.POSITION_CONTROL, targetPositions=q, targetVelocities=qd,
-                     forces=self.forces, positionGains=self._gains[0], velocityGains=self._gains[1])
+        if rate == 1.0:
+            return queue.command(tau)  # (lists of floats already: no conversion)
+        q, qd = queue.state(tau)  # StopMove / StartMove: on the path, at the clock's rate
+        return self._command(q, qd * rate)
+
+    def _command_hold(self, q: np.ndarray) -> tuple | None:
+        """Hold q: commanded once (the motors keep their command), not again at every substep."""
+        if self._held is q:
+            return None
+        command = self._command(q, np.zeros(len(self.joints)))
+        self._held = q
+        return command
+
+    def _command(self, q: np.ndarray, qd: np.ndarray) -> tuple:
+        self._held = None
+        return _floats(q), _floats(qd)
 
 
 def _floats(values) -> list[float]:

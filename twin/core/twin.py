@@ -132,27 +132,35 @@ class Twin:
                 self._place_targets()
             # the drives and the arm are commanded at every physics substep: an arm command held for a whole
             # step moves the flange in bursts that shake a friction grip loose (measured-facts.md)
-            t, h, gripper, robot, world = self.time, self.world.substep, self.gripper, self.robot, self.world
+            t, gripper, robot, world = self.time, self.gripper, self.robot, self.world
             world.solve_for(gripper.pressing or bool(gripper.state.gripped or gripper.state.attached))
             substeps = world.substeps
             gripper.drive(0)
-            if robot is not None:
-                robot.update(t)
+            arm = robot.commands(t, substeps) if robot is not None else None
+            if arm is not None and arm[0] is not None:
+                robot.send(arm[0])
             world.stasis.before_physics(self._machine_still)  # a cell at rest has its loose bodies frozen: thawed
             world.substep_physics()  # before anything may move them
-            if gripper.coasting and (robot is None or robot.holding):
+            if gripper.coasting and (arm is None or not any(arm)):
                 # nothing is commanded anew in the step's other substeps (the drives keep the first one's settings,
                 # the arm its hold), and nothing is measured until the last: the physics alone runs
                 gripper.coast(substeps - 1)
                 for _ in range(substeps - 1):
                     world.substep_physics()
                 gripper.measure(True)
+            elif gripper.coasting:  # the arm moves on, the drives keep their settings
+                gripper.coast(substeps - 1)
+                for k in range(1, substeps):
+                    if arm[k] is not None:
+                        robot.send(arm[k])
+                    world.substep_physics()
+                gripper.measure(True)
             else:
                 gripper.measure(substeps == 1)
                 for k in range(1, substeps):
                     gripper.drive(k)
-                    if robot is not None:
-                        robot.update(t + k * h)
+                    if arm is not None and arm[k] is not None:
+                        robot.send(arm[k])
                     world.substep_physics()
                     gripper.measure(k == substeps - 1)
             self.step_count += 1
