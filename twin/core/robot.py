@@ -309,10 +309,13 @@ class Robot:
         if command is not None:
             self.send(command)
 
-    def commands(self, t: float, n: int) -> list[tuple | None]:
+    def commands(self, t: float, n: int) -> list[tuple | None] | None:
         """The arm's commands for the n substeps from t on, worked out at once (the same as `update` at each of them
         would send: None where it would send nothing): the step sends each before its substep with `send`, and the
-        arm's Python runs once a step, not between substeps, where pybullet has just left the caches cold."""
+        arm's Python runs once a step, not between substeps, where pybullet has just left the caches cold. None: it
+        holds, commanded already (`holding`), and sends nothing."""
+        if self._traj is None and self._paused is None and self._held is self._hold:
+            return None
         return [self._next(t + k * self.dt) for k in range(n)]
 
     def send(self, command: tuple) -> None:
