@@ -152,6 +152,40 @@ def test_a_held_part_stays_put_relative_to_the_fingers_and_slip_stays_down(name)
         assert math.dist(before, relative()) < 0.0002
 
 
+def test_a_heavy_part_lifted_by_the_arm_stays_still_in_the_grip_pressed_by_statics():
+    # two opposed 40 N fingers (20 g each) on a 300 g steel slug: statics says each presses with its effort, 40 N.
+    # Lifted 100 mm by the arm (its acceleration shakes the pair), the slug rises with the fingers (within 1 mm)
+    # and, held 5 s, moves less than 0.2 mm against the TCP, each finger reading status 2, not moving, 40 N within
+    # 10 %, at every step of the lift's end and the hold
+    with Twin.from_station(GRIPPERS["newcomer_2f_steel"]) as tw:
+        tw.move("MoveJ", "grip", 1.0)
+        while tw.robot_busy:
+            tw.step()
+        tw.step(20)
+        z0 = tw.read("slug.z")
+        for f in ("finger_left", "finger_right"):
+            tw.write(f, 0.0)
+        tw.step(round(1.0 / tw.dt))
+        tw.move("MoveL", "lift", 0.5)
+
+        def steady():
+            for f in ("finger_left", "finger_right"):
+                assert tw.read(f + ".status") == 2 and not tw.read(f + ".moving"), (f, tw.step_count)
+                assert abs(tw.read(f + ".force") - 40.0) <= 4.0, (f, tw.read(f + ".force"))
+
+        while tw.robot_busy:
+            tw.step()
+            steady()
+        assert abs(tw.read("slug.z") - z0 - 0.1) <= 0.001
+        tcp = tw.tcp_pose().position
+        start = [tw.read("slug." + a) - tcp[i] for i, a in enumerate("xyz")]
+        for _ in range(round(5.0 / tw.dt)):
+            tw.step()
+            steady()
+        drift = max(abs(tw.read("slug." + a) - tcp[i] - start[i]) for i, a in enumerate("xyz"))
+        assert drift < 0.0002, drift
+
+
 @pytest.mark.parametrize("name", ["newcomer_2f_box", "newcomer_2f", "newcomer_2f_steel", "revolute_chuck", "light_5n"])
 def test_a_resting_part_does_not_creep(name):
     """Boxes and cylinders (a light can, a 300 g steel slug standing on end, a disc, a 10 g cube) left on their

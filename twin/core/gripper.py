@@ -89,8 +89,6 @@ HELD_SHARE = 0.5  # a joint that moved less than this share of its velocity limi
 RESTING_DRIFT = 2.0  # resting drives (`_still_resting`) rest on while each joint stays within this many times the
 # error a quiet drive's holding force allows of its command (at most half its in-position tolerance); past it (a push,
 # a load the holding force gives way to) the loop takes over again
-PIN_DRIFT = 0.5  # pinned drives stay pinned while each spring's force changes by at most this share of its hold
-PIN_PART_RATIO = 5.0  # drives pressing on a part this many times heavier than what each moves itself are pinned (`_pin`)
 MIMIC_ERP = 0.5  # how fast a mimic joint's drift from its master is taken out, per substep
 MIMIC_FORCE_FACTOR = 20.0  # a mimic coupling holds up to this many times the master's effort (a rigid linkage) ...
 MIMIC_SETTLED_FACTOR = 0.005  # ... and this once every finger of a linkage of parallel jaws (each on a joint of its
@@ -299,9 +297,6 @@ class Gripper:
                            for link, finger in self._finger_of_link.items()
                            for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
         self._quiet = False
-        self._pinned = False  # the drives held by `_pin` for the rest of this step
-        self._pin_bounds: tuple | None = None  # (Active, the presses, per input the joint's bounds) while pinned
-        self._steady = False  # every drive stalled or standing, unmoved, at the last step's first substep
         self._resting: tuple | None = None  # (Active, per input the joint's bounds) while the drives rest
         self._gaps: dict[str, tuple[int, float]] = {}  # per fast drive: (substep, its fingers' gap to the nearest
         # target then), as it last looked
@@ -433,8 +428,6 @@ class Gripper:
             # with it would overshoot every substep (a limit cycle: a squeezed heavy ring rocked by its fingers)
             self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * own / (share * h), mass, limit,
                                       own)
-        loaded = [d for d in self.drives.values() if d.mass > d.own]
-        self._pinnable = bool(loaded) and all(d.mass - d.own >= PIN_PART_RATIO * d.own for d in loaded)
 
     def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[str]:
         """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,
@@ -633,18 +626,12 @@ class Gripper:
         self._step_ticks += 1
         self._ticks += 1
         self._substep_count += 1
-        if substep and (self._quiet or self._pinned):
+        if substep and self._quiet:
             return
-        self._pinned = False
         if self._resting is not None:
             if self._still_resting():
                 return
             self._resting = None
-        if self._pin_bounds is not None:
-            if self._still_pinned():
-                self._pinned = True
-                return
-            self._pin_bounds = None
         if not self.active and self._hold is None:
             self._hold = dict(self.command_position)
         elif self.active:
@@ -656,8 +643,6 @@ class Gripper:
             states = self._states = self._joint_states(self.body, self._joint_ids)
         velocities, forces = [], []
         quiet = True
-        steady = substep == 0 and self.pressing and self._pinnable  # (`_pin`)
-        gains, pin_forces = [], []
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
         axes, presses, loads = self.state.axes, self._presses, self._series_loads  # as the last step left them
         constants = self._constants
@@ -708,13 +693,8 @@ class Gripper:
                 forces.append(effort if rigid else min(effort, abs(stiffness * error - damping * joint_speed) + hold))
                 quiet = (quiet and way is None and abs(axes[name].velocity if axes else joint_speed) < moving
                          and stiffness * abs(error) <= hold)
-                if steady:
-                    steady = target == before and abs(moved) < moving
-                    gains.append(min(1.0, speed * h / error) if error * speed > 0.0 else 1.0)
-                    pin_forces.append(effort if rigid else min(effort, abs(stiffness * error) + hold))
                 continue
             if name in turned:
-                steady = False
                 turned.discard(name)
                 if (g - actual) * (before - actual) < 0.0:
                     before = actual  # a new goal the other way: the drive turns at once, from where the joint is
@@ -811,18 +791,8 @@ class Gripper:
                 forces.append(effort)
             else:
                 forces.append(min(effort, abs(stiffness * error - damping * joint_speed) + hold))
-            if steady:
-                steady = target == before and abs(moved) < moving
-                gains.append(min(1.0, speed * h / error) if error * speed > 0.0 else 1.0)
-                pin_forces.append(effort if rigid else min(effort, abs(stiffness * error) + hold))
             quiet = (quiet and before == g and abs(axes[name].velocity if axes else joint_speed) < moving
                      and stiffness * abs(error) <= hold)  # a pressing drive: every substep
-        if substep == 0:
-            if steady and not quiet and self._steady and self.substeps > 1:
-                self._pin(command, pin_forces, gains, [s[0] for s in states])
-                self._quiet, self._holding = quiet, now_holding
-                return
-            self._steady = steady and not quiet
         if quiet and self._quiet and substep == 0:
             # quiet for a second step: the drives rest (`_still_resting`), each held where its command stands by
             # pybullet's own position motor, taking out a substeps-th of its error at each substep (what the
@@ -855,36 +825,6 @@ class Gripper:
                 velocities, forces = self._linkage_command(velocities, forces, False)
             self._motors(self.body, self._motor_ids, pybullet.VELOCITY_CONTROL, targetVelocities=velocities,
                          forces=forces)
-
-    def _pin(self, command: dict[str, float], forces: list[float], gains: list[float], actual: list[float]) -> None:
-        """Hold every drive for the rest of the step with pybullet's position motor: each at its command, taking out
-        the share of its error a substep that the loop asked for (`gains`), with the loop's force. Done when every
-        finger stalls on its part (or stands at its goal) for a second step: the loop would ask the same of them at
-        each substep, a spring's force a hair different, but working it out and changing the motors' limits every
-        substep costs the twin's Python a third more and the solver a quarter more in a carry. `sense` still decides
-        everything after each step. The drives stay pinned while nothing changes (`_still_pinned`)."""
-        positions = [command[name] for name in self.names]
-        if self._linkage:
-            positions, forces = self._linkage_command(positions, forces, True)
-            gains = gains + [gains[i] for i, _, _, _ in self._linkage]
-        self._motors(self.body, self._motor_ids, pybullet.POSITION_CONTROL, targetPositions=positions,
-                     targetVelocities=[0.0] * len(forces), forces=forces, positionGains=gains,
-                     velocityGains=[1.0] * len(forces))
-        self._sent = None  # (the loop's next command is sent whatever it is)
-        self._pinned = True
-        bounds = []
-        for (name, unit, _), q in zip(self._per_input, actual):
-            d = self.drives[name]
-            allowed = min(PIN_DRIFT * d.hold / d.stiffness if d.stiffness else 0.0, 0.5 * IN_POSITION_TOLERANCE[unit])
-            bounds.append((q - allowed, q + allowed))
-        self._pin_bounds = (self.active, dict(self._presses), bounds)
-
-    def _still_pinned(self) -> bool:
-        """Whether pinned drives stay pinned (`_pin`), as they were set: while no setpoint, limit or `Active` changes,
-        the same drives' fingers press on parts, and every joint stays within its bounds (`sense` looks): where its
-        spring's force has changed by at most PIN_DRIFT times its holding force."""
-        active, presses, _ = self._pin_bounds
-        return not (self._new_goal or self._constants is None or active != self.active or presses != self._presses)
 
     def _linkage_command(self, values: list[float], forces: list[float], positions: bool) -> tuple[list, list]:
         """The inputs' motor command (velocities, or positions) and forces, spread over their linkages' joints: each
@@ -1014,12 +954,6 @@ class Gripper:
         return self._joint_ids
 
     @property
-    def coasting(self) -> bool:
-        """The step's first substep's settings hold for its other substeps (`quiet`, or pinned: `_pin`): nothing
-        is commanded or measured before its last."""
-        return self._quiet or self._pinned
-
-    @property
     def quiet(self) -> bool:
         """Every drive stood at its goal, pressing on nothing, at the last step's first substep."""
         return self._quiet
@@ -1028,7 +962,7 @@ class Gripper:
         """After a physics substep: add up the drives' applied forces; after the step's last, read the fingers'
         contact forces. While every drive stands quiet, the step's last substep alone is read (nothing moves in
         between)."""
-        if (self._quiet or self._pinned) and not last:
+        if self._quiet and not last:
             return
         self._n += 1
         before = self._states
@@ -1112,11 +1046,6 @@ class Gripper:
             for q, (lo, hi) in zip(positions, self._resting[1]):
                 if not lo <= q <= hi:
                     self._resting = None  # (the next step's loop takes the error out, and its command is sent)
-                    break
-        if self._pin_bounds is not None:  # pinned drives likewise
-            for q, (lo, hi) in zip(positions, self._pin_bounds[2]):
-                if not lo <= q <= hi:
-                    self._pin_bounds = None
                     break
         friction = self.spec.grip == "friction"
         reached = self._reached(axes) if friction else {}

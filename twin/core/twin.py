@@ -141,14 +141,14 @@ class Twin:
                 robot.send(arm[0])
             world.stasis.before_physics(self._machine_still)  # a cell at rest has its loose bodies frozen: thawed
             world.substep_physics()  # before anything may move them
-            if gripper.coasting and (arm is None or not any(arm)):
+            if gripper.quiet and (arm is None or not any(arm)):
                 # nothing is commanded anew in the step's other substeps (the drives keep the first one's settings,
                 # the arm its hold), and nothing is measured until the last: the physics alone runs
                 gripper.coast(substeps - 1)
                 for _ in range(substeps - 1):
                     world.substep_physics()
                 gripper.measure(True)
-            elif gripper.coasting:  # the arm moves on, the drives keep their settings
+            elif gripper.quiet:  # the arm moves on, the drives keep their settings
                 gripper.coast(substeps - 1)
                 for k in range(1, substeps):
                     if arm[k] is not None:

@@ -41,7 +41,7 @@ LYING = math.cos(math.radians(45.0))  # a cylinder whose axis is nearer the hori
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
 SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
 # rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
-RESIDUAL_SHARE = 5e-3  # ... fewer once converged while fingers press on a part: the solver stops when no contact's or
+RESIDUAL_SHARE = 2e-3  # ... fewer once converged while fingers press on a part: the solver stops when no contact's or
 # drive's impulse changes by more than this share of the lightest loose body's weight over a substep in one sweep
 PYBULLET_RESIDUAL = 1e-7  # pybullet's own threshold (its measure: an impulse's change squared), kept at every other time
 
