@@ -232,11 +232,8 @@ def _words(n: int) -> struct.Struct:
     return struct.Struct(f">{n}H")
 
 
-def _patched(backend, holding: bytes, live: Sequence[tuple[int, int | None]] | None = None) -> bytes:
-    """The holding-register image with its live registers (sim.advance) filled in (`live`: (address, value) as
-    read already)."""
-    if live is None:
-        live = [(a, backend.live_holding(a)) for a in backend.live_addresses]
+def _patched(holding: bytes, live: Sequence[tuple[int, int | None]]) -> bytes:
+    """The holding-register image with its live registers (sim.advance) filled in (`live`: `PduHandler._live_values`)."""
     if all(v is None or 2 * a + 2 > len(holding) or holding[2 * a:2 * a + 2] == _H.pack(v) for a, v in live):
         return holding  # they read as the image has them (sim.advance 0 once the steps are done)
     out = bytearray(holding)
@@ -287,7 +284,7 @@ class PduHandler:
         self._advance = adv if adv is not None and adv.table == HOLDING_REGISTER else None
         self._map_file: MapFile | None = None
         # holding registers read live (sim.advance); a backend that serves no window may have none
-        self._live = tuple(sorted(getattr(backend, "live_addresses", ())))
+        self._live_addresses = tuple(sorted(getattr(backend, "live_addresses", ())))
         # sim.advance's address in the output window
         self._advance_out = (None if self._advance is None
                              else IMAGE_OUT + self.layout.out_offset[HOLDING_REGISTER] + self._advance.address)
@@ -358,16 +355,12 @@ class PduHandler:
         images = self.backend.images
         if table == INPUT_REGISTER:
             return self._outputs(table, address, count).input_registers[2 * address:2 * (address + count)]
-        data = images.holding[2 * address:2 * (address + count)]
-        patched = None
-        for a in self.backend.live_addresses:
-            if address <= a < address + count:
-                v = self.backend.live_holding(a)
-                if v is not None:
-                    if patched is None:
-                        patched = bytearray(data)
-                    struct.pack_into(">H", patched, 2 * (a - address), v)
-        return data if patched is None else bytes(patched)
+        return _patched(images.holding, self._live_values())[2 * address:2 * (address + count)]
+
+    def _live_values(self) -> tuple[tuple[int, int | None], ...]:
+        """The live holding registers as they read now: (address, value, None where the image's word stands)."""
+        live_holding = self.backend.live_holding
+        return tuple([(a, live_holding(a)) for a in self._live_addresses])
 
     def _outputs(self, table: str, address: int, count: int) -> Images:
         """The images an output read is answered from: the connection's poll's, else the latest."""
@@ -391,15 +384,15 @@ class PduHandler:
         start = address - (IMAGE_OUT if address >= IMAGE_OUT else IMAGE_IN)
         if address >= IMAGE_OUT:
             images = self.backend.images
-            window = b"".join(b"\x00" + bytes((b,)) for b in images.coils) + _patched(self.backend, images.holding)
+            window = (b"".join(b"\x00" + bytes((b,)) for b in images.coils)
+                      + _patched(images.holding, self._live_values()))
         else:
             window = self._input_window()
         return window[2 * start:2 * (start + count)]
 
     def _input_window(self) -> bytes:
         images = self.backend.images
-        live_holding = self.backend.live_holding
-        live = tuple([(a, live_holding(a)) for a in self._live])
+        live = self._live_values()
         cached = self._in_cache
         if cached is not None and cached[0] is images and cached[1] == live:
             return cached[2]
@@ -413,7 +406,7 @@ class PduHandler:
         if coils is None or coils[0] is not images.coils:
             coils = parts[COIL] = (images.coils,
                                    pack_words(images.coils, lay.in_offset[HOLDING_REGISTER] - lay.in_offset[COIL]))
-        window = b"".join((di[1], images.input_registers, coils[1], _patched(self.backend, images.holding, live)))
+        window = b"".join((di[1], images.input_registers, coils[1], _patched(images.holding, live)))
         self._in_cache = (images, live, window)
         return window
 
@@ -448,12 +441,11 @@ class PduHandler:
 
     def _holding_words(self, holding: bytes) -> tuple[int, ...]:
         """The holding registers' words as they read now (the live ones filled in), kept while they stay so."""
-        backend = self.backend
-        live = tuple(backend.live_holding(a) for a in backend.live_addresses)
+        live = self._live_values()
         cached = self._holding_cache
         if cached is not None and cached[0] is holding and cached[1] == live:
             return cached[2]
-        h = _patched(backend, holding)
+        h = _patched(holding, live)
         words = _words(len(h) // 2).unpack(h)
         self._holding_cache = (holding, live, words)
         return words
@@ -470,7 +462,7 @@ class PduHandler:
             plan = self._plans[key] = self._window_plan(start, start + len(words))
         changes = []
         images = self.backend.images
-        live = self._live
+        live = self._live_addresses
         current_h = None
         for off, table, a, e, kind, writable in plan:
             if table is None:
