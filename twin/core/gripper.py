@@ -428,6 +428,11 @@ class Gripper:
             # with it would overshoot every substep (a limit cycle: a squeezed heavy ring rocked by its fingers)
             self.drives[name] = Drive(d.velocity, d.effort, stiffness, DAMPING_SHARE * own / (share * h), mass, limit,
                                       own)
+        # how many times the lightest part's mass (at the finger) a finger's own drive moves: the solver's sweeps
+        # needed to squeeze that part between such fingers grow with it (world.py, `World.iterations_for`)
+        own_drives = {servos[0] for servos in self.finger_servos.values() if servos}
+        self.mass_ratio = max((self.drives[n].own / (self.drives[n].mass - self.drives[n].own) for n in own_drives
+                               if self.drives[n].mass > self.drives[n].own), default=0.0)
 
     def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[str]:
         """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,

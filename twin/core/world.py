@@ -39,8 +39,11 @@ ROLLING_RESISTANCE = 3e-4  # m: the rolling friction of a loose cylinder lying o
 # (there it would act at every finger's contact, 0.3 mm times their force, and change how a squeezed part settles)
 LYING = math.cos(math.radians(45.0))  # a cylinder whose axis is nearer the horizontal than this lies on its side
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
-SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
+SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (more for heavy fingers: ITERATIONS_PER_RATIO) (20 holds the five test grippers and the ring
 # rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
+ITERATIONS_PER_RATIO = 3.5  # sweeps per unit of a finger's mass over the lightest part's: a part squeezed between
+# fingers r times its mass converges by about (r - 1) / (r + 1) a sweep, so a thousandth takes ln(1000) r / 2
+MAX_SOLVER_ITERATIONS = 500  # (a 10 g pin between 1 kg jaws: 350)
 RESIDUAL_SHARE = 2e-3  # ... fewer once converged while fingers press on a part: the solver stops when no contact's or
 # drive's impulse changes by more than this share of the lightest loose body's weight over a substep in one sweep
 PYBULLET_RESIDUAL = 1e-7  # pybullet's own threshold (its measure: an impulse's change squared), kept at every other time
@@ -215,6 +218,7 @@ def create_body(c, body: Body) -> int:
     return uid
 
 
+BARE_LINK_DENSITY = 7850.0  # kg/m^3: a gripper link with no <inertial> weighs its collision shapes' volume in steel
 INERTIA_SLACK = 10.0  # a link's inertia more than this many times that of the solid box of its collision shapes (or
 # less than its inverse squared) does not fit its mass and size: an exported placeholder (1 kg m^2 on a 50 g finger)
 _warned: set[tuple[str, str]] = set()  # (URDF, link): each warned of once per process
@@ -225,8 +229,10 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
     """Replace the inertia of every gripper link whose URDF inertia does not fit its mass and collision shapes by
     that of the solid box around those shapes (about its centre of mass, in its inertial frame; a mesh by the box
     around its link); one warning line per link, naming it. A link with no collision shape keeps what the URDF
-    says. `no_inertial`: the gripper links whose URDF has no <inertial> at all (pybullet makes them 1 kg): their
-    warning says so. Returns the warnings."""
+    says. `no_inertial`: the gripper links whose URDF has no <inertial> at all: pybullet makes them 1 kg (a 30 g
+    jaw's drive then moves 30 times its mass, and rocks a light part it squeezes for a second); they weigh their
+    collision shapes' volume in steel instead (BARE_LINK_DENSITY), with that box's inertia, and their warning
+    says so. Returns the warnings."""
     notes = []
     for link, name in sorted(link_name.items()):
         if name.startswith(ROBOT_PREFIX):
@@ -236,9 +242,10 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
         shapes = c.getCollisionShapeData(body, link)
         if mass <= 0.0 or not shapes:
             continue
-        corners = []
+        corners, volume = [], 0.0
         for shape in shapes:
             half = _half_extents(shape[2], shape[3])
+            volume += _volume(shape[2], shape[3])
             if half is None:  # a mesh: the corners of the link's bounding box, in its inertial frame
                 lo, hi = c.getAABB(body, link)
                 com, orn = c.getLinkState(body, link, computeForwardKinematics=True)[:2]
@@ -258,19 +265,23 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
             hi = [max(p[i] for p in corners) for i in range(3)]
             size = [hi[i] - lo[i] for i in range(3)]
             mid = [(hi[i] + lo[i]) / 2 for i in range(3)]
+            bare = name in no_inertial
+            if bare:  # (a mesh's volume: its link's bounding box's)
+                volume = volume or size[0] * size[1] * size[2]
+                mass = BARE_LINK_DENSITY * volume
             box = [mass / 12 * (size[(i + 1) % 3] ** 2 + size[(i + 2) % 3] ** 2)
                    + mass * (mid[(i + 1) % 3] ** 2 + mid[(i + 2) % 3] ** 2) for i in range(3)]
             fits = all(b > 0 and b / INERTIA_SLACK ** 2 <= g <= b * INERTIA_SLACK for g, b in zip(given, box))
-            if fits and name not in no_inertial:
+            if fits and not bare:
                 continue
-            if not fits:
-                c.changeDynamics(body, link, localInertiaDiagonal=box)
-            if name in no_inertial:
-                note = (f"{source}: link {name} has no <inertial>: pybullet makes it {mass:g} kg"
-                        + ("" if fits else f", with an inertia of {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
-                                           f"solid box around its collision shapes at that mass)")
-                        + ": give the link's real mass and inertia")
+            if bare:
+                c.changeDynamics(body, link, mass=mass, localInertiaDiagonal=box)
+                note = (f"{source}: link {name} has no <inertial> (pybullet would make it 1 kg): using {mass:.3g} kg, "
+                        f"its collision shapes' {volume * 1e6:.3g} cm^3 in steel, and an inertia of "
+                        f"{' '.join(f'{b:.3g}' for b in box)} kg m^2 (the solid box around them at that mass): give "
+                        "the link's real mass and inertia")
             else:
+                c.changeDynamics(body, link, localInertiaDiagonal=box)
                 note = (f"{source}: link {name}: inertia {' '.join(f'{g:.3g}' for g in given)} kg m^2 does not fit "
                         f"its {mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
                         f"solid box around them)")
@@ -279,6 +290,19 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
                 _warned.add((source, name))
                 logging.getLogger("twin").warning("warning: %s", note)
     return notes
+
+
+def _volume(kind: int, dims) -> float:
+    """m^3: a collision shape's own volume (a mesh: 0, measured by its link's bounding box instead)."""
+    if kind == pybullet.GEOM_BOX:
+        return dims[0] * dims[1] * dims[2]
+    if kind == pybullet.GEOM_SPHERE:
+        return 4.0 / 3.0 * math.pi * dims[0] ** 3
+    if kind == pybullet.GEOM_CYLINDER:
+        return math.pi * dims[1] ** 2 * dims[0]
+    if kind == pybullet.GEOM_CAPSULE:
+        return math.pi * dims[1] ** 2 * dims[0] + 4.0 / 3.0 * math.pi * dims[1] ** 3
+    return 0.0
 
 
 def _half_extents(kind: int, dims) -> tuple[float, float, float] | None:
@@ -364,7 +388,7 @@ class World:
         self._configure()
         for fixture in station.fixtures:
             self.body_ids[fixture.name] = self._create_body(fixture)
-        flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+        flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER  # (cylinders exact, not hulls)
         gripper = _gripper_for_pybullet(station.gripper.urdf, station.file, Path(self._tmp.name))
         bare = frozenset(link.get("name", "") for link in gripper.iter("link")
                          if link.find("inertial") is None)  # (pybullet makes such a link 1 kg)
@@ -399,6 +423,7 @@ class World:
         # substep keeps both true, and lets the robot and the drives be commanded at every substep
         c.setPhysicsEngineParameter(fixedTimeStep=self.substep, numSubSteps=1, numSolverIterations=SOLVER_ITERATIONS,
                                     deterministicOverlappingPairs=1)
+        self.iterations = SOLVER_ITERATIONS  # (`iterations_for`)
         tolerance = solver_tolerance(st, self.substep)
         # (the solver's measure is the largest squared change of an impulse in a sweep)
         self._residuals = (PYBULLET_RESIDUAL, PYBULLET_RESIDUAL if tolerance is None
@@ -417,6 +442,18 @@ class World:
         self.probe = ContactProbe(self.client, self.machine, finger_links, targets,
                                   lambda client, name: create_body(client, spec[name]))
         return self.probe
+
+    def iterations_for(self, mass_ratio: float) -> int:
+        """Let the solver sweep a substep's contacts and drives up to ITERATIONS_PER_RATIO times `mass_ratio` times
+        (how many times the lightest part's mass a finger's drive moves: `Gripper.mass_ratio`), at least
+        SOLVER_ITERATIONS, at most MAX_SOLVER_ITERATIONS; the solver stops sooner where it converges. Heavy fingers
+        on a light part need them: a 50 g can between 2 kg jaws at 100 N was pressed 0.7 mm deep by one jaw, which
+        read `moving` for 12 steps after touching, with 50. Returns the iterations."""
+        iterations = min(MAX_SOLVER_ITERATIONS, max(SOLVER_ITERATIONS, math.ceil(ITERATIONS_PER_RATIO * mass_ratio)))
+        if iterations != SOLVER_ITERATIONS:
+            self.client.setPhysicsEngineParameter(numSolverIterations=iterations)
+        self.iterations = iterations
+        return iterations
 
     def squeeze_tolerance_within(self, force: float) -> None:
         """Keep the squeeze's tolerance within RESIDUAL_SHARE of `force` (N, the weakest finger's) over a substep too:
