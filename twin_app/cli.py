@@ -100,6 +100,7 @@ def _print_drives(target: str) -> None:
         with Twin.from_station(target) as twin:
             drives, notes = twin.gripper.drives, twin.world.inertia_notes + twin.gripper.effort_notes
             unit, derived = twin.gripper.unit, twin.gripper.derived_notes()
+            ratio, iterations = twin.gripper.mass_ratio, twin.world.iterations
     finally:
         quiet.disabled = level
     rows = [("drive", "velocity", "effort", "stiffness", "damping", "full force at", "moves", "stable up to")]
@@ -118,6 +119,8 @@ def _print_drives(target: str) -> None:
             print("  " + "  ".join("-" * w for w in widths))
     for line in derived:
         print(line)
+    print(f"solver: up to {iterations} sweeps a substep (a finger's drive moves {ratio:.3g} times the lightest part's "
+          "mass; heavier fingers need more: docs/station-format.md, The solver's tolerance)")
     for note in notes:
         print(f"warning: {note}")
 

@@ -8,7 +8,11 @@
 - `light_5n`: a gantry lift carrying two 5 N fingers of 8 g, a 10 g cube;
 - `sloppy_inertia`: a CAD export with 1 kg m^2 inertias on 50 g fingers, two 50 N fingers, a 0.14 kg cylinder;
 - `pr2_mesh`: pybullet_data's PR2 gripper, two revolute fingers with mesh (STL) proximal links, given 2 N m each in
-  place of the URDF's 1000 N m placeholder, closing their pads on a 20 mm peg.
+  place of the URDF's 1000 N m placeholder, closing their pads on a 20 mm peg;
+- `heavy_jaws_light_can`: 2 kg jaws at 100 N on a 50 g can (the part 40 times lighter than either jaw);
+- `round_pads`: fingers whose pads are URDF cylinders (8 mm radius), 60 N each, on a 40 mm aluminium cube;
+- `angular_bare`: two revolute jaws of 0.4 N m as a CAD export leaves them (one with no `<inertial>`, the other a
+  1 kg m^2 placeholder on 30 g), pinching a 16 mm cube of 10 g.
 
 `GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
 grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
@@ -19,7 +23,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
-         "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh")
+         "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh", "heavy_jaws_light_can", "round_pads",
+         "angular_bare")
 GRIPPERS = {name: HERE / name for name in NAMES}
 
 
@@ -46,6 +51,9 @@ GRIPS = {  # every finger closed to its range's end: well past the part, so each
     "sloppy_inertia": Grip("cylinder", {"finger_1_link": 0.0, "finger_2_link": 0.0},
                            {"finger_1_link": 50.0, "finger_2_link": 50.0}),
     "pr2_mesh": Grip("peg", {"left_gripper": 0.0, "right_gripper": 0.0}, {"left_gripper": 2.0, "right_gripper": 2.0}),
+    "heavy_jaws_light_can": Grip("can", {"jaw_l": 0.05, "jaw_r": 0.05}, {"jaw_l": 100.0, "jaw_r": 100.0}),
+    "round_pads": Grip("cube", {"pad_l": 0.04, "pad_r": 0.04}, {"pad_l": 60.0, "pad_r": 60.0}),
+    "angular_bare": Grip("cube", {"jaw_l": 0.5, "jaw_r": 0.5}, {"jaw_l": 0.4, "jaw_r": 0.4}),
 }
 
 

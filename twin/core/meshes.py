@@ -183,6 +183,28 @@ def write_pieces(pieces: list[np.ndarray], path: Path) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
+CYLINDER_SIDES = 48  # a URDF cylinder's surface prism: its sides lie at most 0.2 % of its radius inside the circle
+
+
+def surface_cylinder(radius: float, length: float, out_dir: Path, name: str) -> Path | None:
+    """Write a URDF collision cylinder (its axis along z, centred) as its surface for pybullet: one convex prism of
+    CYLINDER_SIDES sides whose corners lie HULL_MARGIN inside the cylinder's side and ends, which pybullet's margin
+    round its hull brings back out to them (never early: a side's middle 0.2 % of the radius late). pybullet itself
+    makes a URDF cylinder a hull 1 mm proud of it (a round pad touches a part 1 mm early). None when the cylinder is
+    too thin for that (the caller keeps pybullet's hull)."""
+    r, h = radius - HULL_MARGIN, length / 2 - HULL_MARGIN
+    if r <= 0.0 or h <= 0.0:
+        return None
+    n = CYLINDER_SIDES
+    ring = [(r * np.cos(2 * np.pi * k / n), r * np.sin(2 * np.pi * k / n)) for k in range(n)]
+    lines = [f"o {name}"] + [f"v {float(x)!r} {float(y)!r} {z!r}" for z in (-h, h) for x, y in ring]
+    lines += ["f " + " ".join(str(k) for k in range(n, 0, -1)), "f " + " ".join(str(n + k) for k in range(1, n + 1))]
+    lines += [f"f {k + 1} {(k + 1) % n + 1} {n + (k + 1) % n + 1} {n + k + 1}" for k in range(n)]
+    out = out_dir / (name + SUFFIX)
+    out.write_text("\n".join(lines) + "\n")
+    return out
+
+
 def surface_mesh(source: Path, scale: tuple[float, float, float], out_dir: Path, name: str) -> Path | None:
     """Write the mesh file `source` (scaled) as surface prisms into `out_dir` (`name` + SUFFIX); None when it cannot
     be read (the caller keeps the original)."""

@@ -117,12 +117,28 @@ def _read(urdf: Path, file: Path, key: str) -> ET.Element:
 
 
 def _surface_meshes(root: ET.Element, out_dir: Path) -> None:
-    """Every collision mesh (paths already absolute) as the mesh's own surface (twin/core/meshes.py): pybullet's
-    hull of it stands 1 mm proud and fills its hollows. A mesh that cannot be rewritten keeps pybullet's hull."""
-    from .meshes import surface_mesh
+    """Every collision mesh (paths already absolute) and cylinder as its own surface (twin/core/meshes.py): pybullet's
+    hull of either stands 1 mm proud (and fills a mesh's hollows). One that cannot be rewritten keeps pybullet's
+    hull."""
+    from .meshes import surface_cylinder, surface_mesh
 
     done: dict[tuple, str] = {}
     for collision in root.iter("collision"):
+        geometry = collision.find("geometry")
+        cylinder = geometry.find("cylinder") if geometry is not None else None
+        if cylinder is not None:
+            try:
+                radius, length = float(cylinder.get("radius", "")), float(cylinder.get("length", ""))
+            except ValueError:
+                continue  # (pybullet's own loader says what is wrong with it)
+            key = ("cylinder", radius, length)
+            if key not in done:
+                out = surface_cylinder(radius, length, out_dir, f"cylinder{len(done)}")
+                done[key] = str(out) if out is not None else ""
+            if done[key]:
+                geometry.remove(cylinder)
+                ET.SubElement(geometry, "mesh", {"filename": done[key]})
+            continue
         for mesh in collision.iter("mesh"):
             scale = tuple(float(v) for v in (mesh.get("scale") or "1 1 1").split())
             key = (mesh.get("filename"), scale)
@@ -388,7 +404,7 @@ class World:
         self._configure()
         for fixture in station.fixtures:
             self.body_ids[fixture.name] = self._create_body(fixture)
-        flags = pybullet.URDF_USE_INERTIA_FROM_FILE | pybullet.URDF_USE_IMPLICIT_CYLINDER  # (cylinders exact, not hulls)
+        flags = pybullet.URDF_USE_INERTIA_FROM_FILE
         gripper = _gripper_for_pybullet(station.gripper.urdf, station.file, Path(self._tmp.name))
         bare = frozenset(link.get("name", "") for link in gripper.iter("link")
                          if link.find("inertial") is None)  # (pybullet makes such a link 1 kg)
