@@ -234,21 +234,21 @@ def create_body(c, body: Body) -> int:
     return uid
 
 
-BARE_LINK_DENSITY = 7850.0  # kg/m^3: a gripper link with no <inertial> weighs its collision shapes' volume in steel
+STEEL_DENSITY = 7850.0  # kg/m^3: what a gripper link with no <inertial> weighs, over its collision shapes' volume
 INERTIA_SLACK = 10.0  # a link's inertia more than this many times that of the solid box of its collision shapes (or
 # less than its inverse squared) does not fit its mass and size: an exported placeholder (1 kg m^2 on a 50 g finger)
 _warned: set[tuple[str, str]] = set()  # (URDF, link): each warned of once per process
 
 
 def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inertial: frozenset = frozenset()
-                 ) -> list[str]:
+                 ) -> list[tuple[str, str, str]]:
     """Replace the inertia of every gripper link whose URDF inertia does not fit its mass and collision shapes by
     that of the solid box around those shapes (about its centre of mass, in its inertial frame; a mesh by the box
     around its link); one warning line per link, naming it. A link with no collision shape keeps what the URDF
     says. `no_inertial`: the gripper links whose URDF has no <inertial> at all: pybullet makes them 1 kg (a 30 g
     jaw's drive then moves 30 times its mass, and rocks a light part it squeezes for a second); they weigh their
-    collision shapes' volume in steel instead (BARE_LINK_DENSITY), with that box's inertia, and their warning
-    says so. Returns the warnings."""
+    collision shapes' volume in steel instead (STEEL_DENSITY, `link_volume`), with that box's inertia, and their
+    warning says so. Returns (link, "mass" or "inertia", warning) for each."""
     notes = []
     for link, name in sorted(link_name.items()):
         if name.startswith(ROBOT_PREFIX):
@@ -258,10 +258,9 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
         shapes = c.getCollisionShapeData(body, link)
         if mass <= 0.0 or not shapes:
             continue
-        corners, volume = [], 0.0
+        corners = []
         for shape in shapes:
             half = _half_extents(shape[2], shape[3])
-            volume += _volume(shape[2], shape[3])
             if half is None:  # a mesh: the corners of the link's bounding box, in its inertial frame
                 lo, hi = c.getAABB(body, link)
                 com, orn = c.getLinkState(body, link, computeForwardKinematics=True)[:2]
@@ -282,9 +281,9 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
             size = [hi[i] - lo[i] for i in range(3)]
             mid = [(hi[i] + lo[i]) / 2 for i in range(3)]
             bare = name in no_inertial
-            if bare:  # (a mesh's volume: its link's bounding box's)
-                volume = volume or size[0] * size[1] * size[2]
-                mass = BARE_LINK_DENSITY * volume
+            if bare:
+                volume = link_volume(c, body, link)
+                mass = STEEL_DENSITY * volume
             box = [mass / 12 * (size[(i + 1) % 3] ** 2 + size[(i + 2) % 3] ** 2)
                    + mass * (mid[(i + 1) % 3] ** 2 + mid[(i + 2) % 3] ** 2) for i in range(3)]
             fits = all(b > 0 and b / INERTIA_SLACK ** 2 <= g <= b * INERTIA_SLACK for g, b in zip(given, box))
@@ -301,24 +300,29 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
                 note = (f"{source}: link {name}: inertia {' '.join(f'{g:.3g}' for g in given)} kg m^2 does not fit "
                         f"its {mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
                         f"solid box around them)")
-            notes.append(note)
+            notes.append((name, "mass" if bare else "inertia", note))
             if (source, name) not in _warned:
                 _warned.add((source, name))
                 logging.getLogger("twin").warning("warning: %s", note)
     return notes
 
 
-def _volume(kind: int, dims) -> float:
-    """m^3: a collision shape's own volume (a mesh: 0, measured by its link's bounding box instead)."""
-    if kind == pybullet.GEOM_BOX:
-        return dims[0] * dims[1] * dims[2]
-    if kind == pybullet.GEOM_SPHERE:
-        return 4.0 / 3.0 * math.pi * dims[0] ** 3
-    if kind == pybullet.GEOM_CYLINDER:
-        return math.pi * dims[1] ** 2 * dims[0]
-    if kind == pybullet.GEOM_CAPSULE:
-        return math.pi * dims[1] ** 2 * dims[0] + 4.0 / 3.0 * math.pi * dims[1] ** 3
-    return 0.0
+def link_volume(c, body: int, link: int) -> float:
+    """m^3: the summed volume of a link's collision shapes (a mesh: its link's bounding box, at least as much)."""
+    total = 0.0
+    for shape in c.getCollisionShapeData(body, link):
+        kind, dims = shape[2], shape[3]
+        if kind == pybullet.GEOM_BOX:
+            total += dims[0] * dims[1] * dims[2]
+        elif kind == pybullet.GEOM_SPHERE:
+            total += 4 / 3 * math.pi * dims[0] ** 3
+        elif kind in (pybullet.GEOM_CYLINDER, pybullet.GEOM_CAPSULE):
+            r, length = dims[1], dims[0]
+            total += math.pi * r * r * length + (4 / 3 * math.pi * r ** 3 if kind == pybullet.GEOM_CAPSULE else 0.0)
+        else:
+            lo, hi = c.getAABB(body, link)
+            return math.prod(h - l for l, h in zip(lo, hi))  # covers every shape of the link
+    return total
 
 
 def _half_extents(kind: int, dims) -> tuple[float, float, float] | None:
@@ -426,7 +430,9 @@ class World:
             self.joint_index[info[1].decode()] = j
             self.link_index[info[12].decode()] = j
         self.link_name = {j: name for name, j in self.link_index.items()}
-        self.inertia_notes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf), bare)
+        # (link, "mass" or "inertia", warning) per gripper link whose URDF inertial data was replaced
+        self.inertia_fixes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf), bare)
+        self.inertia_notes = [note for _, _, note in self.inertia_fixes]
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
 

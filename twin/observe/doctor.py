@@ -26,6 +26,7 @@ from pathlib import Path
 
 from twin.core.errors import MotionError
 from twin.core.geometry import Pose
+from twin.core.world import STEEL_DENSITY as STEEL, link_volume
 
 PASS, WARN, FAIL, INFO = "PASS", "WARN", "FAIL", "INFO"
 STALL_STEPS = 10  # status 2/1 within this many steps of touching
@@ -46,7 +47,6 @@ TRAVEL_SPEED = 0.5  # m/s: to the approach pose (MoveJ)
 SWEEP_SAMPLES = 400  # positions per range in the reach sweep (refined by bisection)
 CLEARANCE = {"m": 0.01, "rad": 0.2}  # a pre-grip position stands this far off the part (or half the free room)
 FAR = 1.0  # m: the reach sweep's query distance
-STEEL = 7900.0  # kg/m^3
 DENSITY_LIMIT = 3 * STEEL  # a finger link denser than this (osmium, the densest metal, is 22600) has a wrong mass
 PICTURE_PITCH = -15.0  # deg: the grip seen from a little above the part, the fingers in front of the gripper
 
@@ -306,26 +306,6 @@ class _Reach:
             self._restore(saved)
 
 
-def _volume(c, body: int, link: int) -> float:
-    """m^3: the summed volume of a link's collision shapes (a mesh: its link's bounding box, at least as much)."""
-    import pybullet
-
-    total = 0.0
-    for shape in c.getCollisionShapeData(body, link):
-        kind, dims = shape[2], shape[3]
-        if kind == pybullet.GEOM_BOX:
-            total += dims[0] * dims[1] * dims[2]
-        elif kind == pybullet.GEOM_SPHERE:
-            total += 4 / 3 * math.pi * dims[0] ** 3
-        elif kind in (pybullet.GEOM_CYLINDER, pybullet.GEOM_CAPSULE):
-            r, length = dims[1], dims[0]
-            total += math.pi * r * r * length + (4 / 3 * math.pi * r ** 3 if kind == pybullet.GEOM_CAPSULE else 0.0)
-        else:
-            lo, hi = c.getAABB(body, link)
-            return math.prod(h - l for l, h in zip(lo, hi))  # covers every shape of the link
-    return total
-
-
 def _rle(seq: list[int]) -> list[list[int]]:
     out: list[list[int]] = []
     for v in seq:
@@ -511,6 +491,8 @@ class Doctor:
             self.twin.write("Active", True)  # a gripper that is not always active follows its setpoints once told to
         for note in self.g.effort_notes:  # a placeholder effort: the force check below cannot pass, and says so
             self.check(WARN, "station", "drive", "effort", note)
+        for link, measure, note in self.twin.world.inertia_fixes:  # URDF data replaced: the real values are wanted
+            self.check(WARN, "station", link, measure, note)
         self.rest()
         self.densities()
         drive_of = {f: self.reach.closing_drive(f) for f in self.fingers}
@@ -546,7 +528,7 @@ class Doctor:
         for f in self.fingers:
             for link in self.g.finger_links[f]:
                 mass = c.getDynamicsInfo(body, link)[0]
-                volume = _volume(c, body, link)
+                volume = link_volume(c, body, link)
                 if mass <= 0 or not volume:
                     continue
                 density = mass / volume
