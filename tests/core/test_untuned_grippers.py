@@ -440,3 +440,34 @@ def test_a_part_held_still_on_a_fast_arm_raises_no_slip():
                 assert not tw.read("slip"), (tw.step_count, worst)
         assert worst < 0.001, worst
         assert tw.read("doGripped")
+
+
+def test_a_joint_axis_that_is_not_a_unit_vector_is_taken_as_its_direction_with_one_warning(caplog, tmp_path):
+    # URDF: a joint's <axis> is a direction. Written "2 0 0", jaw_l of tests/grippers/heavy_jaws_light_can must still
+    # meet the can where the geometry says (its inner face at x = -(0.05 - q): q = 0.030 for the 40 mm can) and press
+    # with its 100 N effort, and one warning names the joint
+    from twin.core import world
+
+    src = GRIPPERS["heavy_jaws_light_can"]
+    folder = tmp_path / "axis"
+    shutil.copytree(src, folder)
+    urdf = folder / "gripper.urdf"
+    text = urdf.read_text()
+    assert text.count('<axis xyz="1 0 0"/>') == 1
+    urdf.write_text(text.replace('<axis xyz="1 0 0"/>', '<axis xyz="2 0 0"/>'))
+    world._warned.clear()
+    with caplog.at_level(logging.WARNING, logger="twin"):
+        twin = Twin.from_station(folder)
+    with twin:
+        lines = [r.getMessage() for r in caplog.records if "jaw_l_joint" in r.getMessage()]
+        assert len(lines) == 1 and "axis" in lines[0], lines
+        for f in ("jaw_l", "jaw_r"):
+            twin.write(f, 0.05)
+        touched = None
+        for _ in range(round(1.5 / twin.dt)):
+            twin.step()
+            if touched is None and twin.read("jaw_l.contact"):
+                touched = twin.read("jaw_l.actual")
+        assert touched == pytest.approx(0.030, abs=0.05 * twin.dt + 0.00005)
+        assert twin.read("jaw_l.force") == pytest.approx(100.0, rel=0.1)
+        assert twin.read("jaw_l.actual") == pytest.approx(0.030, abs=0.0002)

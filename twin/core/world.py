@@ -109,6 +109,36 @@ def _rigid_for_pybullet(root: ET.Element) -> None:
             joint.set("type", "fixed")
 
 
+def _unit_axes(root: ET.Element, urdf: Path, file: Path) -> list[tuple[str, str, str]]:
+    """Every moving joint's <axis> made a unit vector, as URDF means it: pybullet takes it as written, so a prismatic
+    joint along "1 1 0" travels 1.41 m for a metre of its setpoint and presses with 0.71 times its effort. Returns
+    (joint, "axis", warning) for each axis it scaled; StationError for an axis of no length."""
+    fixes = []
+    for joint in root.findall("joint"):
+        axis = joint.find("axis")
+        if joint.get("type") in ("fixed", None) or axis is None:
+            continue
+        try:
+            xyz = [float(v) for v in (axis.get("xyz") or "1 0 0").split()]
+        except ValueError:
+            continue  # (pybullet's own loader says what is wrong with it)
+        length = math.sqrt(sum(v * v for v in xyz)) if len(xyz) == 3 else 1.0
+        if length == 0.0:
+            raise StationError(str(file), "gripper.urdf", f"{urdf}: joint {joint.get('name')}: axis \"{axis.get('xyz')}\" "
+                               "has no direction (a joint's axis must be a unit vector)")
+        if abs(length - 1.0) > 1e-3:  # (an axis written to a few digits, 0.866 0.5 0, is left as it is: 0.1 % at most)
+            unit = [v / length for v in xyz]
+            axis.set("xyz", " ".join(repr(v) for v in unit))
+            note = (f"{urdf}: joint {joint.get('name')}: axis \"{axis.get('xyz') and ' '.join(f'{v:g}' for v in xyz)}\" "
+                    f"is {length:.4g} long; using the unit vector {' '.join(f'{v:.4g}' for v in unit)} (a URDF axis "
+                    "is a direction: as written it would scale the joint's travel and force)")
+            fixes.append((joint.get("name", ""), "axis", note))
+            if (str(urdf), "joint " + joint.get("name", "")) not in _warned:
+                _warned.add((str(urdf), "joint " + joint.get("name", "")))
+                logging.getLogger("twin").warning("warning: %s", note)
+    return fixes
+
+
 def _read(urdf: Path, file: Path, key: str) -> ET.Element:
     try:
         return ET.parse(urdf).getroot()
@@ -410,6 +440,7 @@ class World:
             self.body_ids[fixture.name] = self._create_body(fixture)
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE
         gripper = _gripper_for_pybullet(station.gripper.urdf, station.file, Path(self._tmp.name))
+        axis_fixes = _unit_axes(gripper, station.gripper.urdf, station.file)
         bare = frozenset(link.get("name", "") for link in gripper.iter("link")
                          if link.find("inertial") is None)  # (pybullet makes such a link 1 kg)
         if station.robot is not None:
@@ -431,8 +462,10 @@ class World:
             self.link_index[info[12].decode()] = j
         self.link_name = {j: name for name, j in self.link_index.items()}
         # (link, "mass" or "inertia", warning) per gripper link whose URDF inertial data was replaced
-        self.inertia_fixes = fix_inertias(self.client, self.machine, self.link_name, str(station.gripper.urdf), bare)
-        self.inertia_notes = [note for _, _, note in self.inertia_fixes]
+        # (link or joint, "mass", "inertia" or "axis", warning) per piece of the gripper's URDF data replaced
+        self.urdf_fixes = axis_fixes + fix_inertias(self.client, self.machine, self.link_name,
+                                                    str(station.gripper.urdf), bare)
+        self.inertia_notes = [note for _, _, note in self.urdf_fixes]
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
 

@@ -491,7 +491,7 @@ class Doctor:
             self.twin.write("Active", True)  # a gripper that is not always active follows its setpoints once told to
         for note in self.g.effort_notes:  # a placeholder effort: the force check below cannot pass, and says so
             self.check(WARN, "station", "drive", "effort", note)
-        for link, measure, note in self.twin.world.inertia_fixes:  # URDF data replaced: the real values are wanted
+        for link, measure, note in self.twin.world.urdf_fixes:  # URDF data replaced: the real values are wanted
             self.check(WARN, "station", link, measure, note)
         self.rest()
         self.densities()
