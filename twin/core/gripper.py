@@ -272,6 +272,9 @@ class Gripper:
         for master, gear, mult in gears:
             if self.joint[master] in jaws and all(j in jaws for j, m, _, _ in self.mimics if m == master):
                 self._gears.setdefault(master, []).append((gear, mult))
+        # linkages whose gears stay rigid (joints in series: a finger's knuckles): the solver needs more sweeps to
+        # hold a chain of gears under load (world.py, `World.iterations_for`)
+        self.rigid_linkages = sorted({master for _, master, _, _ in self.mimics} - set(self._gears))
         # a linkage's drive acts on each of its joints (its master's and its mimics'), each with the drive's force
         # over the sum of the multipliers' sizes: by virtual work the linkage then presses as the drive does (sum |m|
         # f = F), and every joint alike, as a part held between its fingers needs in statics, without the gear

@@ -44,6 +44,7 @@ SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (more 
 ITERATIONS_PER_RATIO = 3.5  # sweeps per unit of a finger's mass over the lightest part's: a part squeezed between
 # fingers r times its mass converges by about (r - 1) / (r + 1) a sweep, so a thousandth takes ln(1000) r / 2
 MAX_SOLVER_ITERATIONS = 500  # (a 10 g pin between 1 kg jaws: 350)
+RIGID_LINKAGE_ITERATIONS = 300  # ... and at least this many where gears tie joints in series (a finger's knuckles)
 RESIDUAL_SHARE = 2e-3  # ... fewer once converged while fingers press on a part: the solver stops when no contact's or
 # drive's impulse changes by more than this share of the lightest loose body's weight over a substep in one sweep
 PYBULLET_RESIDUAL = 1e-7  # pybullet's own threshold (its measure: an impulse's change squared), kept at every other time
@@ -498,13 +499,16 @@ class World:
                                   lambda client, name: create_body(client, spec[name]))
         return self.probe
 
-    def iterations_for(self, mass_ratio: float) -> int:
+    def iterations_for(self, mass_ratio: float, rigid_linkage: bool = False) -> int:
         """Let the solver sweep a substep's contacts and drives up to ITERATIONS_PER_RATIO times `mass_ratio` times
         (how many times the lightest part's mass a finger's drive moves: `Gripper.mass_ratio`), at least
-        SOLVER_ITERATIONS, at most MAX_SOLVER_ITERATIONS; the solver stops sooner where it converges. Heavy fingers
-        on a light part need them: a 50 g can between 2 kg jaws at 100 N was pressed 0.7 mm deep by one jaw, which
-        read `moving` for 12 steps after touching, with 50. Returns the iterations."""
-        iterations = min(MAX_SOLVER_ITERATIONS, max(SOLVER_ITERATIONS, math.ceil(ITERATIONS_PER_RATIO * mass_ratio)))
+        SOLVER_ITERATIONS (RIGID_LINKAGE_ITERATIONS with a `rigid_linkage`: gears in series), at most
+        MAX_SOLVER_ITERATIONS; the solver stops sooner where it converges. Heavy fingers on a light part need them: a
+        50 g can between 2 kg jaws at 100 N was pressed 0.7 mm deep by one jaw, which read `moving` for 12 steps after
+        touching, with 50; and a chain of gears: a two-knuckle finger's distal joint lagged its master by 40-50 mrad
+        under load with 50 to 150 (the grip walked its can 3.6 mm), not with 200 or more. Returns the iterations."""
+        least = RIGID_LINKAGE_ITERATIONS if rigid_linkage else SOLVER_ITERATIONS
+        iterations = min(MAX_SOLVER_ITERATIONS, max(least, math.ceil(ITERATIONS_PER_RATIO * mass_ratio)))
         if iterations != SOLVER_ITERATIONS:
             self.client.setPhysicsEngineParameter(numSolverIterations=iterations)
         self.iterations = iterations

@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from twin.core.errors import MotionError
+from twin.core.bullet import pybullet
 from twin.core.geometry import Pose
 from twin.core.world import STEEL_DENSITY as STEEL, link_volume
 
@@ -306,6 +307,10 @@ class _Reach:
             self._restore(saved)
 
 
+def _cross3(a, b) -> list[float]:
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
 def _rle(seq: list[int]) -> list[list[int]]:
     out: list[list[int]] = []
     for v in seq:
@@ -451,6 +456,35 @@ class Doctor:
         if finger not in mult:
             return 1.0
         return 1.0 / sum(mult.values())  # each coupled finger alike, whatever its own multiplier
+
+    def knuckle_force(self, finger: str, drive: str, target: str, effort: float) -> float | None:
+        """What a finger on a linkage of joints in series (knuckles tied by gears) reads in statics where it touches
+        the part now: by virtual work the drive's effort E balances the contacts' normal forces through the speed of
+        each contact point along its normal for a unit speed of the linkage (every joint of it that carries the
+        finger turning at its multiplier), sum(N_i n_i . v_i) = E; the finger reads the torque of those forces about
+        its own joint (a prismatic finger: their sum). None without a contact."""
+        g, c = self.g, self.c
+        own = self.twin.world.joint_index[next(x.joint for x in self.mech.fingers if x.name == finger)]
+        gear = {g.joint[drive]: 1.0} | {j: mult for j, m, mult, _ in g.mimics if m == drive}
+        moving = [(j, gear[j]) for j in g._chain(own) if j in gear]
+        frames = {j: g._joint_frame(j) for j, _ in moving}
+        revolute = {j: g._joint_kind(j)[0] == pybullet.JOINT_REVOLUTE for j, _ in moving}
+        work = read = 0.0
+        for link in g.finger_links[finger]:
+            for pt in c.getContactPoints(self.body, self.twin.world.body_ids[target], linkIndexA=link):
+                p, n, fn = pt[5], pt[7], pt[9]  # (n: on the part, towards the finger: the part pushes it along n)
+                if fn <= 0.0:
+                    continue
+                speed = [0.0, 0.0, 0.0]
+                for j, mult in moving:
+                    origin, axis = frames[j]
+                    v = _cross3(axis, [p[i] - origin[i] for i in range(3)]) if revolute[j] else axis
+                    speed = [speed[i] + mult * v[i] for i in range(3)]
+                work += fn * abs(sum(n[i] * speed[i] for i in range(3)))
+                origin, axis = frames[own] if own in frames else g._joint_frame(own)
+                arm = _cross3([p[i] - origin[i] for i in range(3)], n) if revolute.get(own, True) else n
+                read += fn * abs(sum(arm[i] * axis[i] for i in range(3)))
+        return effort * read / work if work > 0.0 else None
 
     def carried(self, finger: str) -> list[str]:
         """The other fingers whose links hang from this finger's links: it is a carriage (a lift, a slide), not a
@@ -769,6 +803,8 @@ class Doctor:
             r.penetration = None if pen[f] is None else max(0.0, -pen[f])
             d = drive_of[f]
             r.expected_force = g.chain_effort(d) * self.linkage_share(f, d, fingers)  # the weakest in its chain
+            if d in g.rigid_linkages:  # knuckles in series: what reaches the finger depends on where it touches
+                r.expected_force = self.knuckle_force(f, d, name, g.chain_effort(d)) or r.expected_force
             r.short_of_goal = abs(goal[d] - float(tw.read(f"{d}.actual")))
         result.weight = self.weight(name)
         result.capacity = mu * sum(r.normal_force for r in res.values())
