@@ -563,11 +563,21 @@ class Gripper:
             boxes = [c.getAABB(body, k) for k in shaped]  # a box's centre is a point fixed in its link
             return [(min(b[0][i] for b in boxes) + max(b[1][i] for b in boxes)) / 2 for i in range(3)]
 
+        # one finger: its distance from the part it is nearest to (a ram pressing a part onto an anvil, a jaw closing
+        # on a fixed one with the part between), or from the base where the station has no target
+        alone = None
+        if len(fingers) == 1:
+            here = shape_centre(fingers[0])
+            alone = min((c.getBasePositionAndOrientation(uid)[0] for uid in self.targets.values()),
+                        key=lambda p: math.dist(p, here), default=None)
+            if alone is None:
+                alone = (c.getBasePositionAndOrientation(body)[0] if self.base_link < 0
+                         else c.getLinkState(body, self.base_link, computeForwardKinematics=True)[0])
+
         def points():
             pts = [shape_centre(links) for links in fingers]
-            if len(pts) == 1:  # one finger: its distance from the base (a jaw closing on a fixed one)
-                pts.append(c.getBasePositionAndOrientation(body)[0] if self.base_link < 0
-                           else c.getLinkState(body, self.base_link, computeForwardKinematics=True)[0])
+            if alone is not None:
+                pts.append(alone)
             return pts
 
         def spread(pts, centre):
