@@ -263,6 +263,34 @@ shape = "plane"
     return folder
 
 
+def test_a_ram_pressing_a_part_onto_an_anvil_is_closed_towards_it_and_judged_with_its_weight(tmp_path, capsys):
+    # tests/grippers/ram_press (its URDF's comment): one finger moving down meets the block at q = 0.060 and presses
+    # it onto the anvil with the drive's 50 N plus the ram's 0.2 kg weight, 51.96 N; the doctor closes it that way
+    from tests.grippers import GRIPPERS
+
+    code, text, report = run_check(GRIPPERS["ram_press"], tmp_path, capsys)
+    consistent_exit(code, text)
+    assert code == 0, text
+    (f,) = grip(report, "block", "outside")["fingers"]
+    assert f["contact_geometry"] == pytest.approx(0.060, abs=0.0002)
+    assert f["force"] == pytest.approx(51.96, abs=0.5)
+    assert [run[0] for run in f["status"]][-1] == 2
+
+
+def test_knuckle_fingers_are_judged_by_virtual_work_where_they_touch(tmp_path, capsys):
+    # tests/grippers/knuckle_2f (its URDF's comment): at the contact (q = 0.25 rad) virtual work gives 13.09 N at the
+    # distal pad and 0.215 N m about the distal joint, the finger's own: what the doctor must expect of it (not the
+    # drive's 1 N m, nor half of it)
+    from tests.grippers import GRIPPERS
+
+    code, text, report = run_check(GRIPPERS["knuckle_2f"], tmp_path, capsys)
+    consistent_exit(code, text)
+    assert code == 0, text
+    for f in grip(report, "can", "outside")["fingers"]:
+        assert f["expected_force"] == pytest.approx(0.215, rel=0.03), f
+        assert f["force"] == pytest.approx(0.215, rel=0.05), f
+
+
 def test_revolute_fingers_meet_the_part_where_their_tips_reach_it_and_are_judged_in_torque(tmp_path, capsys):
     torque = 1.0
     station = hinged_station(tmp_path / "st", torque)

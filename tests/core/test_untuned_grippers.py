@@ -156,7 +156,7 @@ def test_a_heavy_part_lifted_by_the_arm_stays_still_in_the_grip_pressed_by_stati
     # two opposed 40 N fingers (20 g each) on a 300 g steel slug: statics says each presses with its effort, 40 N.
     # Lifted 100 mm by the arm (its acceleration shakes the pair), the slug rises with the fingers (within 1 mm)
     # and, held 5 s, moves less than 0.2 mm against the TCP, each finger reading status 2, not moving, 40 N within
-    # 10 %, at every step of the lift's end and the hold
+    # 10 %, at every step of the lift and of the hold
     with Twin.from_station(GRIPPERS["newcomer_2f_steel"]) as tw:
         tw.move("MoveJ", "grip", 1.0)
         while tw.robot_busy:
@@ -388,6 +388,11 @@ def test_a_link_without_an_inertial_block_weighs_its_collision_shapes_in_steel_w
                      for collision in finger.findall("collision") for box in collision.iter("box"))
         mass = twin.world.client.getDynamicsInfo(twin.world.machine, twin.world.link_index[finger.get("name")])[0]
         assert mass == pytest.approx(7850.0 * volume, rel=1e-6), (mass, volume)
+    # a link of two boxes (angular_bare's jaw_l: an arm 4 x 10 x 70 mm and a pad 6 x 20 x 8 mm, turned): their
+    # volumes summed, 3.76 cm^3, not the box around them (about 18 cm^3)
+    with Twin.from_station(GRIPPERS["angular_bare"]) as twin:
+        mass = twin.world.client.getDynamicsInfo(twin.world.machine, twin.world.link_index["jaw_l"])[0]
+        assert mass == pytest.approx(7850.0 * (0.004 * 0.01 * 0.07 + 0.006 * 0.02 * 0.008), rel=1e-6)
 
 
 def test_round_pads_touch_the_part_where_their_cylinders_meet_it():
@@ -406,7 +411,7 @@ def test_round_pads_touch_the_part_where_their_cylinders_meet_it():
                 if inp not in first and twin.read(f"{inp}.contact"):
                     first[inp] = twin.read(f"{inp}.actual")
         for inp in ("pad_l", "pad_r"):
-            assert abs(first[inp] - 0.032) <= 0.00005 + 0.05 * 0.012, (inp, first[inp])  # (a step's travel at most)
+            assert abs(first[inp] - 0.032) <= 0.00005 + 0.05 * twin.dt, (inp, first[inp])  # (a step's travel at most)
             assert abs(twin.read(f"{inp}.actual") - 0.032) <= 0.00005, (inp, twin.read(f"{inp}.actual"))
 
 
@@ -471,3 +476,24 @@ def test_a_joint_axis_that_is_not_a_unit_vector_is_taken_as_its_direction_with_o
         assert touched == pytest.approx(0.030, abs=0.05 * twin.dt + 0.00005)
         assert twin.read("jaw_l.force") == pytest.approx(100.0, rel=0.1)
         assert twin.read("jaw_l.actual") == pytest.approx(0.030, abs=0.0002)
+
+
+def test_knuckles_and_a_ram_close_on_their_parts_where_the_geometry_says():
+    # the URDFs' comments: knuckle_2f's fingers meet the can at q = 0.25 rad with the distal knuckle following its
+    # master (multiplier 1: the same angle, within a few milliradians under load); ram_press's ram meets the block
+    # at q = 0.060 and presses it with its drive's 50 N and its own weight (0.2 x 9.81 N): 51.96 N
+    with Twin.from_station(GRIPPERS["knuckle_2f"]) as twin:
+        for inp in ("prox_l", "prox_r"):
+            twin.write(inp, 0.6)
+        twin.step(round(1.5 / twin.dt))
+        c, w = twin.world.client, twin.world
+        for side in ("l", "r"):
+            prox = twin.read(f"prox_{side}.actual")
+            dist = c.getJointState(w.machine, w.joint_index[f"dist_{side}"])[0]
+            assert prox == pytest.approx(0.25, abs=0.003), (side, prox)
+            assert dist == pytest.approx(prox, abs=0.003), (side, prox, dist)
+    with Twin.from_station(GRIPPERS["ram_press"]) as twin:
+        twin.write("ram", 0.08)
+        twin.step(round(1.5 / twin.dt))
+        assert twin.read("ram.actual") == pytest.approx(0.060, abs=0.00005)
+        assert twin.read("ram.force") == pytest.approx(51.96, abs=0.5)
