@@ -98,7 +98,8 @@ def _print_drives(target: str) -> None:
     level, quiet.disabled = quiet.disabled, True  # its warnings are listed below, once
     try:
         with Twin.from_station(target) as twin:
-            drives, notes = twin.gripper.drives, twin.world.inertia_notes + twin.gripper.effort_notes
+            drives = twin.gripper.drives
+            notes = [note for _, _, note in twin.world.urdf_fixes] + twin.gripper.effort_notes
             unit, derived = twin.gripper.unit, twin.gripper.derived_notes()
             ratio, iterations = twin.gripper.mass_ratio, twin.world.iterations
     finally:
@@ -120,7 +121,7 @@ def _print_drives(target: str) -> None:
     for line in derived:
         print(line)
     print(f"solver: up to {iterations} sweeps a substep (a finger's drive moves {ratio:.3g} times the lightest part's "
-          "mass; heavier fingers need more: docs/station-format.md, The solver's tolerance)")
+          "mass; heavier fingers need more: docs/station-format.md, The solver's sweeps)")
     for note in notes:
         print(f"warning: {note}")
 

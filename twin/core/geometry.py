@@ -12,6 +12,11 @@ from typing import Iterable
 import numpy as np
 
 
+def cross(a, b) -> tuple[float, float, float]:
+    """a x b of two 3-vectors as plain floats (per contact point: numpy costs more than the arithmetic there)."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product a*b of quaternions (x, y, z, w): rotate by b, then by a."""
     ax, ay, az, aw = a

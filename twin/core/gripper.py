@@ -58,6 +58,7 @@ from dataclasses import dataclass, field
 
 from .bullet import pybullet
 
+from .geometry import cross
 from .mechanism import JointInput, Mechanism
 from .meshes import HULL_MARGIN, prepared
 from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # (what the signals mean)
@@ -945,7 +946,7 @@ class Gripper:
         if self._joint_kind(joint)[0] == pybullet.JOINT_PRISMATIC:
             motion = axis
         else:  # the contact point's motion about the axis: axis x (point - origin)
-            motion = _cross(axis, [point[5][i] - origin[i] for i in range(3)])
+            motion = cross(axis, [point[5][i] - origin[i] for i in range(3)])
         return sum(motion[i] * point[7][i] for i in range(3)) * mult * speed < 0.0
 
     def read_along(self, joints: list[int]) -> None:
@@ -1027,7 +1028,7 @@ class Gripper:
         # the contact's whole force on B (the normal on B points at A, the finger: -n N; and its friction), as the
         # joint carries it in statics (the normal force alone reads 10 % short where friction carries a share)
         f = [-(pt[7][i] * pt[9] + pt[10] * pt[11][i] + pt[12] * pt[13][i]) for i in range(3)]
-        tau = _cross(r, f)
+        tau = cross(r, f)
         return sum(tau[i] * axis[i] for i in range(3))
 
     def _joint_kind(self, joint: int) -> tuple[int, tuple]:
@@ -1288,10 +1289,6 @@ class Gripper:
             self._release()
         if self._grip_reference is not None and self._grip_reference[0] == name:
             self._grip_reference = None
-
-
-def _cross(a, b) -> tuple[float, float, float]:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def _rotate(orn, v):

@@ -314,7 +314,7 @@ class Robot:
         would send: None where it would send nothing): the step sends each before its substep with `send`, and the
         arm's Python runs once a step, not between substeps, where pybullet has just left the caches cold. None: it
         holds, commanded already (`holding`), and sends nothing."""
-        if self._traj is None and self._paused is None and self._held is self._hold:
+        if self.holding:
             return None
         return [self._next(t + k * self.dt) for k in range(n)]
 

@@ -142,17 +142,12 @@ class Twin:
                 robot.send(arm[0])
             world.stasis.before_physics(self._machine_still)  # a cell at rest has its loose bodies frozen: thawed
             world.substep_physics()  # before anything may move them
-            if gripper.quiet and (arm is None or not any(arm)):
-                # nothing is commanded anew in the step's other substeps (the drives keep the first one's settings,
-                # the arm its hold), and nothing is measured until the last: the physics alone runs
-                gripper.coast(substeps - 1)
-                for _ in range(substeps - 1):
-                    world.substep_physics()
-                gripper.measure(True)
-            elif gripper.quiet:  # the arm moves on, the drives keep their settings
+            if gripper.quiet:
+                # the drives keep the first substep's settings for the step's other substeps, and nothing is measured
+                # until the last: the physics runs, and the arm's commands where it moves
                 gripper.coast(substeps - 1)
                 for k in range(1, substeps):
-                    if arm[k] is not None:
+                    if arm is not None and arm[k] is not None:
                         robot.send(arm[k])
                     world.substep_physics()
                 gripper.measure(True)

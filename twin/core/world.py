@@ -39,8 +39,9 @@ ROLLING_RESISTANCE = 3e-4  # m: the rolling friction of a loose cylinder lying o
 # (there it would act at every finger's contact, 0.3 mm times their force, and change how a squeezed part settles)
 LYING = math.cos(math.radians(45.0))  # a cylinder whose axis is nearer the horizontal than this lies on its side
 OVERLAP_TOLERANCE = 0.0002  # m: a target resting on a fixture touches it; deeper than this it overlaps
-SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (more for heavy fingers: ITERATIONS_PER_RATIO) (20 holds the five test grippers and the ring
-# rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50) ...
+SOLVER_ITERATIONS = 50  # pybullet solver iterations per substep, at most (20 holds the five test grippers and the ring
+# rig within 2.6 % of statics and saves 25-40 % of the physics, but the PLC fault scenarios differ: kept at 50; more for
+# heavy fingers and knuckles, `World.iterations_for`) ...
 ITERATIONS_PER_RATIO = 3.5  # sweeps per unit of a finger's mass over the lightest part's: a part squeezed between
 # fingers r times its mass converges by about (r - 1) / (r + 1) a sweep, so a thousandth takes ln(1000) r / 2
 MAX_SOLVER_ITERATIONS = 500  # (a 10 g pin between 1 kg jaws: 350)
@@ -130,13 +131,12 @@ def _unit_axes(root: ET.Element, urdf: Path, file: Path) -> list[tuple[str, str,
         if abs(length - 1.0) > 1e-3:  # (an axis written to a few digits, 0.866 0.5 0, is left as it is: 0.1 % at most)
             unit = [v / length for v in xyz]
             axis.set("xyz", " ".join(repr(v) for v in unit))
-            note = (f"{urdf}: joint {joint.get('name')}: axis \"{axis.get('xyz') and ' '.join(f'{v:g}' for v in xyz)}\" "
-                    f"is {length:.4g} long; using the unit vector {' '.join(f'{v:.4g}' for v in unit)} (a URDF axis "
-                    "is a direction: as written it would scale the joint's travel and force)")
-            fixes.append((joint.get("name", ""), "axis", note))
-            if (str(urdf), "joint " + joint.get("name", "")) not in _warned:
-                _warned.add((str(urdf), "joint " + joint.get("name", "")))
-                logging.getLogger("twin").warning("warning: %s", note)
+            name = joint.get("name", "")
+            note = (f"{urdf}: joint {name}: axis \"{' '.join(f'{v:g}' for v in xyz)}\" is {length:.4g} long; using the "
+                    f"unit vector {' '.join(f'{v:.4g}' for v in unit)} (a URDF axis is a direction: as written it "
+                    "would scale the joint's travel and force)")
+            fixes.append((name, "axis", note))
+            _warn_once(str(urdf), "joint " + name, note)
     return fixes
 
 
@@ -268,7 +268,14 @@ def create_body(c, body: Body) -> int:
 STEEL_DENSITY = 7850.0  # kg/m^3: what a gripper link with no <inertial> weighs, over its collision shapes' volume
 INERTIA_SLACK = 10.0  # a link's inertia more than this many times that of the solid box of its collision shapes (or
 # less than its inverse squared) does not fit its mass and size: an exported placeholder (1 kg m^2 on a 50 g finger)
-_warned: set[tuple[str, str]] = set()  # (URDF, link): each warned of once per process
+_warned: set[tuple[str, str]] = set()  # (URDF, link or joint): each warned of once per process
+
+
+def _warn_once(source: str, what: str, note: str) -> None:
+    """Log `note` as the twin's warning, once per process for `what` of URDF `source`."""
+    if (source, what) not in _warned:
+        _warned.add((source, what))
+        logging.getLogger("twin").warning("warning: %s", note)
 
 
 def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inertial: frozenset = frozenset()
@@ -332,9 +339,7 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
                         f"its {mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
                         f"solid box around them)")
             notes.append((name, "mass" if bare else "inertia", note))
-            if (source, name) not in _warned:
-                _warned.add((source, name))
-                logging.getLogger("twin").warning("warning: %s", note)
+            _warn_once(source, name, note)
     return notes
 
 
@@ -462,11 +467,9 @@ class World:
             self.joint_index[info[1].decode()] = j
             self.link_index[info[12].decode()] = j
         self.link_name = {j: name for name, j in self.link_index.items()}
-        # (link, "mass" or "inertia", warning) per gripper link whose URDF inertial data was replaced
         # (link or joint, "mass", "inertia" or "axis", warning) per piece of the gripper's URDF data replaced
         self.urdf_fixes = axis_fixes + fix_inertias(self.client, self.machine, self.link_name,
                                                     str(station.gripper.urdf), bare)
-        self.inertia_notes = [note for _, _, note in self.urdf_fixes]
         for target in station.targets:
             self.body_ids[target.name] = self._create_body(target)
 

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from twin.core.errors import MotionError
 from twin.core.bullet import pybullet
-from twin.core.geometry import Pose
+from twin.core.geometry import Pose, cross
 from twin.core.world import STEEL_DENSITY as STEEL, link_volume
 
 PASS, WARN, FAIL, INFO = "PASS", "WARN", "FAIL", "INFO"
@@ -307,10 +307,6 @@ class _Reach:
             self._restore(saved)
 
 
-def _cross3(a, b) -> list[float]:
-    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-
-
 def _rle(seq: list[int]) -> list[list[int]]:
     out: list[list[int]] = []
     for v in seq:
@@ -469,6 +465,8 @@ class Doctor:
         moving = [(j, gear[j]) for j in g._chain(own) if j in gear]
         frames = {j: g._joint_frame(j) for j, _ in moving}
         revolute = {j: g._joint_kind(j)[0] == pybullet.JOINT_REVOLUTE for j, _ in moving}
+        own_origin, own_axis = frames[own] if own in frames else g._joint_frame(own)
+        own_revolute = revolute.get(own, g._joint_kind(own)[0] == pybullet.JOINT_REVOLUTE)
         work = read = 0.0
         for link in g.finger_links[finger]:
             for pt in c.getContactPoints(self.body, self.twin.world.body_ids[target], linkIndexA=link):
@@ -478,12 +476,11 @@ class Doctor:
                 speed = [0.0, 0.0, 0.0]
                 for j, mult in moving:
                     origin, axis = frames[j]
-                    v = _cross3(axis, [p[i] - origin[i] for i in range(3)]) if revolute[j] else axis
+                    v = cross(axis, [p[i] - origin[i] for i in range(3)]) if revolute[j] else axis
                     speed = [speed[i] + mult * v[i] for i in range(3)]
                 work += fn * abs(sum(n[i] * speed[i] for i in range(3)))
-                origin, axis = frames[own] if own in frames else g._joint_frame(own)
-                arm = _cross3([p[i] - origin[i] for i in range(3)], n) if revolute.get(own, True) else n
-                read += fn * abs(sum(arm[i] * axis[i] for i in range(3)))
+                arm = cross([p[i] - own_origin[i] for i in range(3)], n) if own_revolute else n
+                read += fn * abs(sum(arm[i] * own_axis[i] for i in range(3)))
         return effort * read / work if work > 0.0 else None
 
     def carried(self, finger: str) -> list[str]:
