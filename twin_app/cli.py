@@ -101,7 +101,7 @@ def _print_drives(target: str) -> None:
             drives = twin.gripper.drives
             notes = [note for _, _, note in twin.world.urdf_fixes] + twin.gripper.effort_notes
             unit, derived = twin.gripper.unit, twin.gripper.derived_notes()
-            ratio, iterations = twin.gripper.mass_ratio, twin.world.iterations
+            ratio, iterations, spring = twin.gripper.mass_ratio, twin.world.iterations, twin.gripper.spring_sweeps
     finally:
         quiet.disabled = level
     rows = [("drive", "velocity", "effort", "stiffness", "damping", "full force at", "moves", "stable up to")]
@@ -121,7 +121,8 @@ def _print_drives(target: str) -> None:
     for line in derived:
         print(line)
     print(f"solver: up to {iterations} sweeps a substep (a finger's drive moves {ratio:.3g} times the lightest part's "
-          "mass; heavier fingers need more: docs/station-format.md, The solver's sweeps)")
+          f"mass, heavier fingers need more; its spring builds its force on its own links in {spring:.3g} sweeps, "
+          "lighter fingers need more: docs/station-format.md, The solver's sweeps)")
     for note in notes:
         print(f"warning: {note}")
 

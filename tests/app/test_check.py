@@ -277,6 +277,38 @@ def test_a_ram_pressing_a_part_onto_an_anvil_is_closed_towards_it_and_judged_wit
     assert [run[0] for run in f["status"]][-1] == 2
 
 
+def test_light_jaws_on_a_heavy_block_press_with_their_effort(tmp_path, capsys):
+    # tests/grippers/light_jaws_heavy_block (its URDF's comment): 20 g jaws at 300 N on a 4 kg steel block, each
+    # pressing with its drive's 300 N (with pybullet's 50 sweeps a substep they pressed 145 N: world.py,
+    # SPRING_SWEEP_MARGIN)
+    from tests.grippers import GRIPPERS
+
+    code, text, report = run_check(GRIPPERS["light_jaws_heavy_block"], tmp_path, capsys)
+    consistent_exit(code, text)
+    assert code == 0, text
+    for f in grip(report, "block", "outside")["fingers"]:
+        assert f["force"] == pytest.approx(300.0, rel=0.1)
+
+
+def test_an_off_centre_part_pushed_by_the_first_finger_is_judged_from_the_grips_closing(tmp_path, capsys):
+    # the newcomer's block 8 mm off centre along the closing axis: one jaw meets it 16 mm before the other does and
+    # pushes it over (moving: status 0) until the other meets it; each jaw's status is judged from the grip's closing
+    # (both jaws on the block), and the jaw that pushed is no failure
+    folder = newcomer_station(tmp_path / "off_centre", 40.0)
+    toml = folder / "station.toml"
+    sx, sy, sz = BLOCK
+    toml.write_text(toml.read_text().replace(f"xyz = [0.0, 0.0, {sz / 2}]", f"xyz = [0.0, 0.008, {sz / 2}]"))
+    code, text, report = run_check(folder, tmp_path, capsys)
+    consistent_exit(code, text)
+    fingers = grip(report, "block", "outside")["fingers"]
+    onsets = sorted(f["onset_step"] for f in fingers)
+    assert onsets[1] - onsets[0] >= 5  # (8 mm at 50 mm/s each way: 0.08 s, about 7 steps)
+    status = [ln for ln in lines(text, "PASS") if " status: " in ln]
+    assert len(status) == 2 and any("the grip closing" in ln for ln in status), text
+    for f in fingers:
+        assert f["force"] == pytest.approx(40.0, rel=0.1)
+
+
 def test_knuckle_fingers_are_judged_by_virtual_work_where_they_touch(tmp_path, capsys):
     # tests/grippers/knuckle_2f (its URDF's comment): at the contact (q = 0.25 rad) virtual work gives 13.09 N at the
     # distal pad and 0.215 N m about the distal joint, the finger's own: what the doctor must expect of it (not the

@@ -14,7 +14,8 @@
 - `angular_bare`: two revolute jaws of 0.4 N m as a CAD export leaves them (one with no `<inertial>`, the other a
   1 kg m^2 placeholder on 30 g), pinching a 16 mm cube of 10 g;
 - `knuckle_2f`: two fingers of two knuckles each (a driven proximal joint, a mimic distal one), 1 N m, on a 90 g can;
-- `ram_press`: one finger, a 50 N ram moving down, pressing a 200 g block onto an anvil (a fixture).
+- `ram_press`: one finger, a 50 N ram moving down, pressing a 200 g block onto an anvil (a fixture);
+- `light_jaws_heavy_block`: 20 g jaws at 300 N on a 4 kg steel block (the part 200 times heavier than either jaw).
 
 `GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
 grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
@@ -26,7 +27,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
          "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh", "heavy_jaws_light_can", "round_pads",
-         "angular_bare", "knuckle_2f", "ram_press")
+         "angular_bare", "knuckle_2f", "ram_press", "light_jaws_heavy_block")
 GRIPPERS = {name: HERE / name for name in NAMES}
 
 
@@ -59,6 +60,7 @@ GRIPS = {  # every finger closed to its range's end: well past the part, so each
     # (the finger's own joint is the distal knuckle: the torque about it by virtual work, gripper.urdf's comment)
     "knuckle_2f": Grip("can", {"prox_l": 0.6, "prox_r": 0.6}, {"dist_l": 0.215, "dist_r": 0.215}),
     "ram_press": Grip("block", {"ram": 0.08}, {"ram": 51.96}),  # (the drive's 50 N and the ram's weight)
+    "light_jaws_heavy_block": Grip("block", {"jaw_l": 0.05, "jaw_r": 0.05}, {"jaw_l": 300.0, "jaw_r": 300.0}),
 }
 
 

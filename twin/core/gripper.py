@@ -437,6 +437,11 @@ class Gripper:
         own_drives = {servos[0] for servos in self.finger_servos.values() if servos}
         self.mass_ratio = max((self.drives[n].own / (self.drives[n].mass - self.drives[n].own) for n in own_drives
                                if self.drives[n].mass > self.drives[n].own), default=0.0)
+        # the sweeps a finger's own drive needs to build its spring's force on its own links, K h^2 / m_own: many where
+        # its spring was derived for a part far heavier than the finger (world.py, `SPRING_SWEEP_MARGIN`; a rigid drive,
+        # a station's choice, presses with its effort at any error and is left out)
+        self.spring_sweeps = max((self.drives[n].stiffness * h * h / self.drives[n].own for n in own_drives
+                                  if not self.drives[n].rigid), default=0.0)
 
     def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[str]:
         """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,

@@ -69,7 +69,8 @@ class Twin:
                                self.world.substep, self.world.contact_probe, self.world.substeps)
         if self.gripper.finger_forces:
             self.world.squeeze_tolerance_within(min(self.gripper.finger_forces.values()))
-        self.world.iterations_for(self.gripper.mass_ratio, bool(self.gripper.rigid_linkages))
+        self.world.iterations_for(self.gripper.mass_ratio, bool(self.gripper.rigid_linkages),
+                                  self.gripper.spring_sweeps)
         self.robot = None
         if st.robot is not None:
             from .geometry import Pose

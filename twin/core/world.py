@@ -46,6 +46,10 @@ ITERATIONS_PER_RATIO = 3.5  # sweeps per unit of a finger's mass over the lighte
 # fingers r times its mass converges by about (r - 1) / (r + 1) a sweep, so a thousandth takes ln(1000) r / 2
 MAX_SOLVER_ITERATIONS = 500  # (a 10 g pin between 1 kg jaws: 350)
 RIGID_LINKAGE_ITERATIONS = 300  # ... and at least this many where gears tie joints in series (a finger's knuckles)
+SPRING_SWEEP_MARGIN = 2.0  # ... and at least this many times K h^2 / m_own for a finger's drive: a sweep adds at most its
+# own links' mass times the speed its motor asks (e / h) to the motor's impulse, so its spring's force K e is built in
+# K h^2 / m_own sweeps, large where light fingers squeeze a heavy part (K derived for both): 20 g jaws at 300 N on a 4 kg
+# block (101) pressed 145 N each with 50, and pushed an off-centre block 7 mm on through the grip with 100
 RESIDUAL_SHARE = 2e-3  # ... fewer once converged while fingers press on a part: the solver stops when no contact's or
 # drive's impulse changes by more than this share of the lightest loose body's weight over a substep in one sweep
 PYBULLET_RESIDUAL = 1e-7  # pybullet's own threshold (its measure: an impulse's change squared), kept at every other time
@@ -502,15 +506,18 @@ class World:
                                   lambda client, name: create_body(client, spec[name]))
         return self.probe
 
-    def iterations_for(self, mass_ratio: float, rigid_linkage: bool = False) -> int:
+    def iterations_for(self, mass_ratio: float, rigid_linkage: bool = False, spring_sweeps: float = 0.0) -> int:
         """Let the solver sweep a substep's contacts and drives up to ITERATIONS_PER_RATIO times `mass_ratio` times
         (how many times the lightest part's mass a finger's drive moves: `Gripper.mass_ratio`), at least
-        SOLVER_ITERATIONS (RIGID_LINKAGE_ITERATIONS with a `rigid_linkage`: gears in series), at most
+        SOLVER_ITERATIONS (RIGID_LINKAGE_ITERATIONS with a `rigid_linkage`: gears in series) and SPRING_SWEEP_MARGIN
+        times `spring_sweeps` (the most K h^2 / m_own of a finger's drive: `Gripper.spring_sweeps`), at most
         MAX_SOLVER_ITERATIONS; the solver stops sooner where it converges. Heavy fingers on a light part need them: a
         50 g can between 2 kg jaws at 100 N was pressed 0.7 mm deep by one jaw, which read `moving` for 12 steps after
-        touching, with 50; and a chain of gears: a two-knuckle finger's distal joint lagged its master by 40-50 mrad
-        under load with 50 to 150 (the grip walked its can 3.6 mm), not with 200 or more. Returns the iterations."""
-        least = RIGID_LINKAGE_ITERATIONS if rigid_linkage else SOLVER_ITERATIONS
+        touching, with 50; so do light fingers on a heavy part (SPRING_SWEEP_MARGIN); and a chain of gears: a
+        two-knuckle finger's distal joint lagged its master by 40-50 mrad under load with 50 to 150 (the grip walked
+        its can 3.6 mm), not with 200 or more. Returns the iterations."""
+        least = max(RIGID_LINKAGE_ITERATIONS if rigid_linkage else SOLVER_ITERATIONS,
+                    math.ceil(SPRING_SWEEP_MARGIN * spring_sweeps))
         iterations = min(MAX_SOLVER_ITERATIONS, max(least, math.ceil(ITERATIONS_PER_RATIO * mass_ratio)))
         if iterations != SOLVER_ITERATIONS:
             self.client.setPhysicsEngineParameter(numSolverIterations=iterations)

@@ -7,7 +7,7 @@ brings the open gripper over the part and down (`Twin.move`); the drives close t
 they press with their full effort); the grip is held at rest; with a robot the part is lifted. Every measure is
 judged against issue 18's thresholds (docs/check.md says why each one):
 
-    status     2 (closing) / 1 (opening) within 10 steps of touching, and steady while pressing, `moving` off
+    status     2 (closing) / 1 (opening) within 10 steps of the grip closing (its last finger touching), and steady while pressing, `moving` off
     noise      the pressing joint's position spread while pressing <= 0.05 mm (0.001 rad)
     force      the finger's force = its drive's effort (the weakest in a chain of drives in series, shared over a
                mimic linkage) within 10 %
@@ -827,22 +827,26 @@ class Doctor:
                 f"[gripper.joints.{r.drive}] stiffness) gives the whole effort")
 
     def judge(self, where, want, status, res, moving, result, mu) -> None:
+        # the grip closes when its last finger touches: one that touched first pushes an off-centre part over to the
+        # others, moving (status 0), and stalls only once they hold it
+        closed = max((r.onset_step for r in res.values() if r.onset_step is not None), default=None)
         for f, r in res.items():
             if r.onset_step is None:
                 self.check(FAIL, where, f, "contact", f"never touched the part (geometry: contact at "
                            f"{_fmt_pos(r.contact_geometry, r.unit)})")
                 continue
-            # status: the wanted value within STALL_STEPS of touching, and from then on for good
+            # status: the wanted value within STALL_STEPS of the grip closing, and from then on for good
             seq = status[f]
-            settled = next((k for k in range(r.onset_step - 1, len(seq)) if all(s == want for s in seq[k:])), None)
-            late = None if settled is None else settled + 1 - r.onset_step
+            settled = next((k for k in range(closed - 1, len(seq)) if all(s == want for s in seq[k:])), None)
+            late = None if settled is None else settled + 1 - closed
             runs = _runs(r.status)
+            since = "touching" if closed == r.onset_step else f"the grip closing (every finger touching, step {closed})"
             if late is not None and late <= STALL_STEPS:
-                self.check(PASS, where, f, "status", f"{want} within {max(late, 0)} steps of touching, steady to "
+                self.check(PASS, where, f, "status", f"{want} within {max(late, 0)} steps of {since}, steady to "
                            f"the end ({runs})")
             else:
                 flips = len(r.status) - 1
-                self.check(FAIL, where, f, "status", f"not a steady {want} from {STALL_STEPS} steps after touching "
+                self.check(FAIL, where, f, "status", f"not a steady {want} from {STALL_STEPS} steps after {since} "
                            f"(sequence {runs}; {flips} changes)")
             lim = NOISE[r.unit]
             self.check(PASS if r.noise <= lim else FAIL, where, f, "noise",
