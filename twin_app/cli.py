@@ -63,6 +63,9 @@ def _remarks(mech) -> list[str]:
 
 def cmd_info(args) -> int:
     mech = _mechanism_of(args.target)
+    # the station's physics is loaded before anything is printed: a station that does not load (a mesh not found)
+    # prints its one error line, not half a report
+    drives = _drive_lines(args.target) if Path(args.target).suffix.lower() != ".urdf" and not args.json else []
     if args.json:
         print(json.dumps(mech.as_dict(), indent=2))
         for line in _remarks(mech):
@@ -82,12 +85,12 @@ def cmd_info(args) -> int:
     print(f"fingers ({len(mech.fingers)}): " + ", ".join(f.label for f in mech.fingers))
     for line in _remarks(mech):
         print(line)
-    if Path(args.target).suffix.lower() != ".urdf":
-        _print_drives(args.target)
+    for line in drives:
+        print(line)
     return 0
 
 
-def _print_drives(target: str) -> None:
+def _drive_lines(target: str) -> list[str]:
     """The station's drives as the twin derives them (docs/station-format.md, "Drives"), and the URDF data it
     replaced: this loads the station's physics."""
     import logging as _logging
@@ -113,18 +116,16 @@ def _print_drives(target: str) -> None:
                      f"{d.full_error * (1000 if m else 1):.3g} {'mm' if m else 'rad'}",
                      f"{d.mass:.4g} {'kg' if m else 'kg m^2'}", f"{d.limit:.4g}"))
     widths = [max(len(r[c]) for r in rows) for c in range(len(rows[0]))]
-    print("drives (derived from the masses, the effort and the step; docs/station-format.md, Drives):")
+    out = ["drives (derived from the masses, the effort and the step; docs/station-format.md, Drives):"]
     for n, row in enumerate(rows):
-        print("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
+        out.append("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)).rstrip())
         if n == 0:
-            print("  " + "  ".join("-" * w for w in widths))
-    for line in derived:
-        print(line)
-    print(f"solver: up to {iterations} sweeps a substep (a finger's drive moves {ratio:.3g} times the lightest part's "
-          f"mass, heavier fingers need more; its spring builds its force on its own links in {spring:.3g} sweeps, "
-          "lighter fingers need more: docs/station-format.md, The solver's sweeps)")
-    for note in notes:
-        print(f"warning: {note}")
+            out.append("  " + "  ".join("-" * w for w in widths))
+    out += derived
+    out.append(f"solver: up to {iterations} sweeps a substep (a finger's drive moves {ratio:.3g} times the lightest "
+               f"part's mass, heavier fingers need more; its spring builds its force on its own links in {spring:.3g} "
+               "sweeps, lighter fingers need more: docs/station-format.md, The solver's sweeps)")
+    return out + [f"warning: {note}" for note in notes]
 
 
 def cmd_demo(args) -> int:

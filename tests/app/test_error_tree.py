@@ -89,6 +89,18 @@ def test_each_command_prints_one_line_for_a_project_error(tmp_path):
     assert code == 2 and err.startswith("twin: ") and "bad.mod:3:" in err  # FILE:LINE:COL of the program
     code, err = one_line_error(["twin", "info", str(tmp_path / "nothing.urdf")])
     assert code == 2 and err.startswith("twin: error: ") and "nothing.urdf" in err
+    # a station whose URDF names a mesh that is not there: its one error line, and nothing of a report before it
+    meshless = tmp_path / "meshless"
+    meshless.mkdir()
+    urdf = (STATIONS / "smart_gripper" / "smart_gripper.urdf").read_text()
+    box = '<collision><origin xyz="0 0 0.04"/><geometry><box size="0.06 0.12 0.08"/></geometry></collision>'
+    assert box in urdf
+    (meshless / "smart_gripper.urdf").write_text(urdf.replace(
+        box, '<collision><geometry><mesh filename="meshes/pad.stl"/></geometry></collision>'))
+    (meshless / "station.toml").write_text(text)
+    run = subprocess.run([sys.executable, "-m", "twin", "info", str(meshless)], capture_output=True, text=True,
+                         cwd=ROOT, timeout=120)
+    assert run.returncode == 2 and run.stdout == "" and "meshes/pad.stl" in run.stderr, (run.stdout, run.stderr)
     code, err = one_line_error(["rapid_like", "run", str(broken / "bad.mod"), "--set", "x=1"])
     # a usage mistake exits 2 as argparse's own (and twin's, plc's) do, naming the option it is about
     assert code == 2 and err.startswith("rapid: error: ") and "--set" in err and "'x=1'" in err

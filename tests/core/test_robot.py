@@ -13,6 +13,7 @@ from twin.core.geometry import Pose, slerp
 from twin.core.kinematics import ArmKinematics
 from twin.core.motion import Speed, movec, movej, movel, moveabsj
 from twin.core.robot import Robot
+from twin.core.twin import Twin
 
 ARM = STATIONS / "robots" / "arm6700.urdf"
 DOWN = (math.pi, 0.0, 0.0)  # the tool points straight down
@@ -273,3 +274,23 @@ def test_a_blocked_motion_ends_with_a_fault_naming_the_target(kin, cell):
     assert steps * DT == pytest.approx(traj.duration + cell.robot.settle_timeout, abs=2 * DT)
     assert cell.robot.fault is not None and "'grip_right': not reached" in cell.robot.fault
     assert cell.robot.tcp_pose().position[2] > 0.3
+
+
+def test_run_motion_raises_naming_the_target_when_the_table_stops_the_arm_short(tmp_path):
+    # tests/grippers/newcomer_2f with a target 80 mm below the grip: the open fingers' tips meet the table before the
+    # TCP gets there, and the motion must not end as if it had arrived
+    import shutil
+
+    from tests.grippers import GRIPPERS
+
+    folder = tmp_path / "blocked"
+    shutil.copytree(GRIPPERS["newcomer_2f"], folder)
+    toml = folder / "station.toml"
+    text = toml.read_text().replace('urdf = "../../../stations/robots/arm6700.urdf"',
+                                    f'urdf = "{(STATIONS / "robots" / "arm6700.urdf").as_posix()}"')
+    toml.write_text(text.replace("[robot.targets]\n",
+                                 '[robot.targets]\nthrough = { xyz = [1.6, -0.8, 0.36], rpy_deg = [180.0, 0.0, 0.0] }\n'))
+    with Twin.from_station(folder) as twin:
+        with pytest.raises(MotionError, match=r"'through'.*not reached"):
+            twin.run_motion("MoveL", "through", 0.1)
+        assert twin.tcp_pose().position[2] > 0.36 + 0.01  # (it stood short of the target: the table held it)

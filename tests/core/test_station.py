@@ -40,6 +40,11 @@ def test_missing_required_key_is_named(tmp_path):
     assert "targets[0].radius: is required" in msg
 
 
+def test_a_misspelt_required_key_is_named_with_the_key_it_stands_for(tmp_path):
+    msg = error_for(tmp_path, GOOD.replace("radius = 0.04\n", "radus = 0.04\n"))
+    assert "targets[0].radius: is required (is 'radus' a misspelling of it?)" in msg
+
+
 def test_wrong_type_is_named(tmp_path):
     msg = error_for(tmp_path, GOOD.replace("density = 1200.0", 'density = "heavy"'))
     assert "targets[0].density: must be a number" in msg

@@ -28,8 +28,9 @@ spring, derived for finger and part, would rattle the light carriage between a s
 A station's stiffness above that limit makes its drive rigid up to its effort. A free finger follows its command with
 almost no force; a finger stopped by a part presses with K times how far its setpoint lies past it, up to the effort.
 What the PLC reads is measured, not computed: `NAME.effort` is the
-motor force pybullet applied (averaged over the substeps), `NAME.force` the normal force of the finger's contacts on
-target objects (as the step's last substep leaves them, as a sensor samples; a revolute finger's is the torque about its joint of those contacts' force, friction included),
+motor force pybullet applied (averaged over the substeps), `NAME.force` the force of the finger's contacts on target
+objects along its joint's axis, friction included (as the step's last substep leaves them, as a sensor samples; a
+revolute finger's is the torque about its joint of those contacts' force),
 and an axis's speed comes from its positions (pybullet's joint velocity reads the motor's target where a contact
 holds the joint back). Mimic joints are tied to their master by a gear constraint (one motor moves the whole
 linkage). Stepping by hand (fixedTimeStep = step / substeps, one stepSimulation per substep) keeps both motor limits
@@ -72,6 +73,8 @@ STIFFNESS_SHARE = 1.0  # ... at most this share of the stiffest spring the step 
 DAMPING_SHARE = 1.0  # the damping: this share of the strongest the step keeps stable, D h / m per drive
 HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
 PUSH_SPEEDUP = 20.0  # how much faster than its velocity limit a held drive asks to move
+FACING = 0.9999  # a contact whose normal lies within 14 mrad of a prismatic finger's axis: its friction's share of
+# the force along the axis is left out (its friction acts across the axis within 1.4 %), the rest is summed
 LATCH_FRACTION = 0.975  # a drive pressing with this share of its full-force error stalls: its command waits there
 # (K e + the holding force: 99.5 % of its effort), and the rest of its effort holds the finger where it stands; a part
 # that gives way is followed back to that error (the force stays), one that pushes back meets up to the whole effort
@@ -1010,6 +1013,7 @@ class Gripper:
         sums, key_of = self._force_sum, self._link_keys.get
         if self._joint_frames:
             self._joint_frames.clear()
+        axes = self._joint_frames
         for pt in self._contact_points(self.body):  # one query for all of the machine's contacts (a crowded cell's
             # parts that touch nothing cost nothing), its finger links' on targets kept
             force = pt[9]
@@ -1021,6 +1025,20 @@ class Gripper:
             key, revolute = key
             if revolute:
                 force = abs(self._torque(key[0], pt))
+            else:  # the contact's whole force along the finger's joint axis (`_thrust`, here in line: every contact)
+                frame = axes.get(key[0])
+                if frame is None:
+                    frame = self._thrust_axis(key[0])
+                if frame:
+                    a0, a1, a2 = frame
+                    n = pt[7]
+                    along = n[0] * a0 + n[1] * a1 + n[2] * a2
+                    if -FACING < along < FACING:  # (facing the axis closer than that: friction adds < 1.4 % of it)
+                        d1, d2 = pt[11], pt[13]
+                        force = abs(along * force + (d1[0] * a0 + d1[1] * a1 + d1[2] * a2) * pt[10]
+                                    + (d2[0] * a0 + d2[1] * a1 + d2[2] * a2) * pt[12])
+                    else:
+                        force *= abs(along)
             sums[key] = sums.get(key, 0.0) + force
 
     def _torque(self, finger: str, pt) -> float:
@@ -1035,6 +1053,17 @@ class Gripper:
         f = [-(pt[7][i] * pt[9] + pt[10] * pt[11][i] + pt[12] * pt[13][i]) for i in range(3)]
         tau = cross(r, f)
         return sum(tau[i] * axis[i] for i in range(3))
+
+    def _thrust_axis(self, finger: str) -> tuple | bool:
+        """A prismatic finger's joint axis in the world, read once a step (its direction: where its link stood at the
+        last substep's start, a few microradians off). The contacts' whole force (normal and friction) along it is
+        what its drive carries in statics, whatever way they face (a V-groove's flanks, a part turned in the grip),
+        as a revolute finger's torque (`_torque`). False for a finger on a fixed joint: its contacts' normal force."""
+        joint = self.finger_joint[finger]
+        kind, axis = self._joint_kind(joint)
+        frame = kind == pybullet.JOINT_PRISMATIC and _rotate(self.client.getLinkState(self.body, joint)[5], axis)
+        self._joint_frames[finger] = frame
+        return frame
 
     def _joint_kind(self, joint: int) -> tuple[int, tuple]:
         """A joint's type and its axis in its own frame (read from pybullet once)."""

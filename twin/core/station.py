@@ -201,6 +201,14 @@ class _Reader:
     def error(self, name: str, message: str) -> StationError:
         return StationError(str(self.file), self.key(name), message)
 
+    def missing(self, name: str, what: str = "") -> StationError:
+        """A required key not given; a key given here that reads like it is named (`densty` for `density`)."""
+        import difflib
+
+        given = [k for k in self.table if k not in self.used or k == name]
+        like = difflib.get_close_matches(name, [k for k in given if k != name], n=1, cutoff=0.75)
+        return self.error(name, f"is required{what}" + (f" (is {like[0]!r} a misspelling of it?)" if like else ""))
+
     def has(self, name: str) -> bool:
         return name in self.table
 
@@ -208,7 +216,7 @@ class _Reader:
         self.used.add(name)
         if name not in self.table:
             if default is ...:
-                raise self.error(name, "is required")
+                raise self.missing(name)
             return default
         value = self.table[name]
         kinds = kind if isinstance(kind, tuple) else (kind,)
@@ -246,7 +254,7 @@ class _Reader:
         self.used.add(name)
         if name not in self.table:
             if required:
-                raise self.error(name, "is required (a table)")
+                raise self.missing(name, " (a table)")
             return None
         value = self.table[name]
         if not isinstance(value, dict):

@@ -363,13 +363,18 @@ class Twin:
         return pose if tool is None else pose * self.kinematics.tool.inverse() * tool
 
     def run_motion(self, instr: str, target, speed: float = 1.0, *, max_time: float = 120.0, **kw) -> None:
-        """Start a motion and step until the robot is in position."""
+        """Start a motion and step until the robot is in position. MotionError when it does not get there: still
+        moving after `max_time`, or stopped short of its target (blocked: not in position `settle_timeout` after the
+        motion's planned end; the arm then holds where it got to)."""
         self.move(instr, target, speed, **kw)
         limit = self.step_count + round(max_time / self.dt)
         while self.robot_busy:
             if self.step_count >= limit:
                 raise MotionError(str(kw.get("name") or target), f"still moving after {max_time:g} s")
             self.step()
+        fault = self.robot.fault  # ("target 'NAME': not reached ...": MotionError names the target itself)
+        if fault:
+            raise MotionError(str(kw.get("name") or target), fault.split(": ", 1)[-1])
 
     # -- physical state -----------------------------------------------------------------------------
     @property
