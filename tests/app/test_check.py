@@ -155,10 +155,11 @@ def test_a_part_beside_the_fingers_fails_on_reach_for_each_finger(tmp_path, caps
 
 
 def test_drives_too_soft_to_reach_their_effort_fail_on_force(tmp_path, capsys):
-    # the docs' drive model: a finger stopped on a part presses with K x (setpoint past the part), up to its
-    # effort. The doctor closes to the range's end (q = 0), 15 mm past the block's side (q = 15 mm): with the
-    # effort reached only at 50 mm of error, each finger presses with K x 15 mm = 30 % of its effort.
-    effort, full_error = 40.0, 0.05
+    # the docs' drive model: a finger stopped on a part short of its setpoint presses with its effort, unless its
+    # drive's full-force error is more than 3 times its joint's range (40 mm: a spring this soft is a placeholder's
+    # sign): then with K x (setpoint past the part). The doctor closes to the range's end (q = 0), 15 mm past the
+    # block's side (q = 15 mm): with the effort reached only at 200 mm of error, each finger presses with K x 15 mm
+    effort, full_error = 40.0, 0.2
     past = BLOCK[1] / 2 - 0.0
     share = min(1.0, past / full_error)
     assert share < 1 - 0.1  # statics says: the force check must fail
@@ -171,7 +172,7 @@ stiffness = {effort / full_error}
     for jaw in ("jaw_a", "jaw_b"):
         assert any(f" {jaw} force: " in ln for ln in lines(text, "FAIL")), text
         finger = next(f for f in grip(report, "block", "outside")["fingers"] if f["finger"] == jaw)
-        assert finger["force"] == pytest.approx(share * effort, rel=0.2)  # what K x error gives, not the effort
+        assert finger["force"] == pytest.approx(share * effort + 0.02 * effort, rel=0.2)  # K x error (+ 2 % held)
         # and it says why: the range ends the block's half width past where the finger stands on it
         line = next(ln for ln in lines(text, "FAIL") if f" {jaw} force: " in ln)
         said = re.search(r"its range ends only ([\d.]+) mm past", line)

@@ -99,7 +99,7 @@ def test_a_contact_flag_rises_only_where_the_finger_touches_the_part(name):
 
 @pytest.mark.parametrize("name", [
     "newcomer_2f",
-    "newcomer_2f_box", "newcomer_2f_steel", "light_5n", "sloppy_inertia", "light_jaws_heavy_block"])
+    "newcomer_2f_box", "newcomer_2f_steel", "light_5n", "sloppy_inertia", "light_jaws_heavy_block", "watch_2n"])
 def test_two_fingers_squeezing_a_part_stay_still_from_ten_steps_after_touching_through_reaching_full_force(name):
     """The issue's rule for as long as it presses, the moment both drives reach their force limit included: two
     equal opposed fingers press alike (statics: no net force on the part), so neither finger may jump when the
@@ -122,7 +122,7 @@ def test_two_fingers_squeezing_a_part_stay_still_from_ten_steps_after_touching_t
             assert twin.read(f"{f}.force") == pytest.approx(statics, rel=0.1), f
 
 
-@pytest.mark.parametrize("name", ["newcomer_2f_box", "parallel_200n", "light_5n", "light_jaws_heavy_block"])
+@pytest.mark.parametrize("name", ["newcomer_2f_box", "parallel_200n", "light_5n", "light_jaws_heavy_block", "watch_2n"])
 def test_a_closing_centred_grip_hardly_pushes_the_part(name):
     with Twin.from_station(GRIPPERS[name]) as twin:
         part = GRIPS[name].part
@@ -132,7 +132,8 @@ def test_a_closing_centred_grip_hardly_pushes_the_part(name):
         assert math.dist(start[:2], twin.object_pose(part)[0][:2]) < 0.0005
 
 
-@pytest.mark.parametrize("name", ["newcomer_2f", "revolute_chuck", "light_5n", "light_jaws_heavy_block"])
+@pytest.mark.parametrize("name", ["newcomer_2f", "revolute_chuck", "light_5n", "light_jaws_heavy_block",
+                                  "watch_2n"])
 def test_a_held_part_stays_put_relative_to_the_fingers_and_slip_stays_down(name):
     with Twin.from_station(GRIPPERS[name]) as twin:
         grip, _ = close_on_part(twin, name)

@@ -26,7 +26,8 @@ they keep their goals instead of trading places with it at equal limits; one sta
 off it, and holds it rigidly where the springs in series would press with the chain's weakest effort anyway (its
 spring, derived for finger and part, would rattle the light carriage between a standing part and a constant force).
 A station's stiffness above that limit makes its drive rigid up to its effort. A free finger follows its command with
-almost no force; a finger stopped by a part presses with K times how far its setpoint lies past it, up to the effort.
+almost no force; a finger stopped by a part presses with K times how far its command runs on past it, up to the
+effort, and with the effort once stalled short of its setpoint (past a goal that lies closer: `_past`).
 What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the force of the finger's contacts on target
 objects along its joint's axis, friction included (as the step's last substep leaves them, as a sensor samples; a
@@ -73,6 +74,10 @@ STIFFNESS_SHARE = 1.0  # ... at most this share of the stiffest spring the step 
 DAMPING_SHARE = 1.0  # the damping: this share of the strongest the step keeps stable, D h / m per drive
 HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free finger; static friction of a drive)
 PUSH_SPEEDUP = 20.0  # how much faster than its velocity limit a held drive asks to move
+PAST_REACH = 3.0  # ... if its full-force error is at most this many times its joint's range: beyond, the effort is a
+# placeholder (1000 N m on a 0.1 kg finger), and the finger presses with what its spring gives (a warning says so)
+PAST_GAP = IN_POSITION_TOLERANCE  # a drive held by a part further than this short of a goal that lies closer past it
+# than its full-force error presses past its goal (`Gripper._past`); nearer its goal, it is at its setpoint
 FACING = 0.9999  # a contact whose normal lies within 14 mrad of a prismatic finger's axis: its friction's share of
 # the force along the axis is left out (its friction acts across the axis within 1.4 %), the rest is summed
 LATCH_FRACTION = 0.975  # a drive pressing with this share of its full-force error stalls: its command waits there
@@ -246,6 +251,9 @@ class Gripper:
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
         self._stalled: dict[str, float | None] = {}  # input -> the direction it presses in, while stalled on a part
+        # inputs stalled past their goal: a goal that lies closer past the part than the drive's full-force error (a
+        # short stroke's range end) is pressed past, with the effort, not with what the spring gives at the goal
+        self._past: set[str] = set()
         self._new_goal: set[str] = set()  # inputs given a setpoint since their drive last ran
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
@@ -467,14 +475,14 @@ class Gripper:
         notes = []
         for name, d in self.drives.items():
             lo, hi = self._range[name]
-            if d.stiffness > d.limit or d.full_error <= hi - lo:
+            if d.stiffness > d.limit or d.full_error <= PAST_REACH * (hi - lo):
                 continue
             m = self.unit[name] == "m"
             u, k = ("N", "N/m") if m else ("N m", "N m/rad")
             _warn_once(notes, f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest "
                               f"position loop the {self.h * 1000:g} ms substep keeps stable for what it moves "
                               f"({d.stiffness:.4g} {k}) needs {d.full_error:.3g} {self.unit[name]} of following error for "
-                              f"it, more than the joint's range ({hi - lo:.3g} {self.unit[name]}): a finger presses with "
+                              f"it, more than {PAST_REACH:g} times the joint's range ({hi - lo:.3g} {self.unit[name]}): a finger presses with "
                               f"at most {d.stiffness * (hi - lo):.3g} {u}. A placeholder? Give the drive's real effort in "
                               f"[gripper.joints.{name}] effort")
         return notes
@@ -671,6 +679,7 @@ class Gripper:
         velocities, forces = [], []
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
+        past, units = self._past, self.unit
         axes, presses, loads = self.state.axes, self._presses, self._series_loads  # as the last step left them
         constants = self._constants
         if constants is None:
@@ -727,13 +736,14 @@ class Gripper:
                     before = actual  # a new goal the other way: the drive turns at once, from where the joint is
                     stalled[name] = None
             way = stalled.get(name)
-            if way is not None and (g - before) * way > 0.0 and (before - actual) * way > release:
+            if (way is not None and (before - actual) * way > release
+                    and ((g - before) * way > 0.0 or name in past and (g - actual) * way > PAST_GAP[units[name]])):
                 # stalled on a part: the command waits, so the finger holds where the part stopped it
                 target = before
                 if (target - actual) * way < follow:
                     # the part gave way: followed, pressing as stalled
                     target = actual + way * latch
-                    if (g - target) * way < 0.0:
+                    if (g - target) * way < 0.0 and name not in past:
                         target = g
             else:
                 way = None
@@ -759,6 +769,17 @@ class Gripper:
                     target = actual + (1.0 if target > actual else -1.0) * latch
                 # held short of its goal by a part, at its force limit: stalled
                 way = 1.0 if target > actual else -1.0
+            elif (way is None and target == g and pressing and name in self._pressing_past
+                  and PAST_GAP[units[name]] < (g - actual) * (1.0 if g > actual else -1.0) < latch
+                  and (moved if g > actual else -moved) < held_speed):
+                # held by a part short of a goal that lies closer past it than full force (a short stroke closed to
+                # its range's end): it presses past the goal, with its effort as any stalled drive (the spring at the
+                # goal would give a fraction of it); it aims at the goal again once the part gives way to there
+                way = 1.0 if g > actual else -1.0
+                target = actual + way * latch
+                past.add(name)
+            if way is None or (g - target) * way > 0.0 or (g - actual) * way <= PAST_GAP[units[name]]:
+                past.discard(name)
             stalled[name] = way
             command[name] = target
             error = target - actual
@@ -875,6 +896,12 @@ class Gripper:
         limit, whether it presses through drives in series (and which hold others), whether it has springs in series,
         its own links' share of its mass, and the drive's rigidity, stiffness, damping and holding force."""
         out = []
+        # the drives that may press past a goal lying closer past the part than their full force (`_past`): each alone
+        # on its finger (no drives in series), not rigid, its effort within reach of its range (PAST_REACH)
+        self._pressing_past = {name for name, d in self.drives.items()
+                               if not (d.rigid or name in self._series_loads or name in self._series_holders
+                                       or self._series[name] > 1)
+                               and d.full <= PAST_REACH * (self._range[name][1] - self._range[name][0])}
         for name, _, moving in self._per_input:
             d = self.drives[name]
             full = d.full
