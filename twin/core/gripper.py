@@ -26,8 +26,8 @@ they keep their goals instead of trading places with it at equal limits; one sta
 off it, and holds it rigidly where the springs in series would press with the chain's weakest effort anyway (its
 spring, derived for finger and part, would rattle the light carriage between a standing part and a constant force).
 A station's stiffness above that limit makes its drive rigid up to its effort. A free finger follows its command with
-almost no force; a finger stopped by a part presses with K times how far its command runs on past it, up to the
-effort, and with the effort once stalled short of its setpoint (past a goal that lies closer: `_past`).
+almost no force; a finger stopped by a part presses with K times how far its setpoint lies past it, up to the
+effort (and with the effort where it was sent to its range's end, however close past the part: `_past`).
 What the PLC reads is measured, not computed: `NAME.effort` is the
 motor force pybullet applied (averaged over the substeps), `NAME.force` the force of the finger's contacts on target
 objects along its joint's axis, friction included (as the step's last substep leaves them, as a sensor samples; a
@@ -54,6 +54,7 @@ The grip rule (`sense`, after each step), the same for outside and inside grips:
 """
 from __future__ import annotations
 
+import collections
 import logging
 import math
 from dataclasses import dataclass, field
@@ -63,7 +64,8 @@ from .bullet import pybullet
 from .geometry import cross
 from .mechanism import JointInput, Mechanism
 from .meshes import HULL_MARGIN, prepared
-from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED  # (what the signals mean)
+from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED, MOVING_WINDOW  # (what the
+# signals mean)
 from .signals import FLOAT, INPUT, SignalSpec
 from .station import GripperSpec
 from .world import COLLISION_MARGIN
@@ -136,6 +138,7 @@ class AxisState:
     actual: float = 0.0
     velocity: float = 0.0
     effort: float = 0.0  # the drive's applied force (N) or torque (N*m), signed along the joint axis
+    moving: bool = False  # faster than MOVING_SPEED over the last step and over the last MOVING_WINDOW (`NAME.moving`)
 
 
 @dataclass
@@ -251,8 +254,8 @@ class Gripper:
         self.setpoint = {inp.name: self._initial(inp) for inp in mechanism.inputs}
         self.command_position = dict(self.setpoint)  # where each servo is heading now (moves at the velocity limit)
         self._stalled: dict[str, float | None] = {}  # input -> the direction it presses in, while stalled on a part
-        # inputs stalled past their goal: a goal that lies closer past the part than the drive's full-force error (a
-        # short stroke's range end) is pressed past, with the effort, not with what the spring gives at the goal
+        # inputs stalled past their range's end, sent there: an end that lies closer past the part than the drive's
+        # full-force error (a short stroke) is pressed past, with the effort, not with what the spring gives there
         self._past: set[str] = set()
         self._new_goal: set[str] = set()  # inputs given a setpoint since their drive last ran
         self._hold: dict[str, float] | None = None
@@ -320,6 +323,8 @@ class Gripper:
         # the drive command last sent (pybullet keeps it: an identical one is not sent again)
         self._states = None
         self._step_positions: list[float] | None = None  # the joints' positions at the end of the last step
+        # the joints' positions at the ends of the last steps, over MOVING_WINDOW (whether each moves: `sense`)
+        self._window = collections.deque(maxlen=max(1, round(MOVING_WINDOW / (substeps * substep))))
         self._step_ticks = 0  # physics substeps since the last sense
         self._speeds = [0.0] * len(self.names)  # each joint's speed over the last substep(s) measured, from positions
         self._ticks = 0  # physics substeps since the joints were last read
@@ -679,7 +684,7 @@ class Gripper:
         velocities, forces = [], []
         quiet = True
         drives, command, stalled, turned = self.drives, self.command_position, self._stalled, self._new_goal
-        past, units = self._past, self.unit
+        past, units, ends = self._past, self.unit, self._range
         axes, presses, loads = self.state.axes, self._presses, self._series_loads  # as the last step left them
         constants = self._constants
         if constants is None:
@@ -771,10 +776,13 @@ class Gripper:
                 way = 1.0 if target > actual else -1.0
             elif (way is None and target == g and pressing and name in self._pressing_past
                   and PAST_GAP[units[name]] < (g - actual) * (1.0 if g > actual else -1.0) < latch
-                  and (moved if g > actual else -moved) < held_speed):
-                # held by a part short of a goal that lies closer past it than full force (a short stroke closed to
-                # its range's end): it presses past the goal, with its effort as any stalled drive (the spring at the
-                # goal would give a fraction of it); it aims at the goal again once the part gives way to there
+                  and (moved if g > actual else -moved) < held_speed
+                  and (g >= ends[name][1] - PAST_GAP[units[name]] if g > actual
+                       else g <= ends[name][0] + PAST_GAP[units[name]])):
+                # held by a part short of its range's end, sent there (closed all the way), the end closer past the
+                # part than full force (a short stroke): it presses past the end, with its effort as any stalled drive
+                # (the spring at the end would give a fraction of it: a setpoint within the range presses with what
+                # the spring gives there); it aims at its goal again once the part gives way to there
                 way = 1.0 if g > actual else -1.0
                 target = actual + way * latch
                 past.add(name)
@@ -1118,10 +1126,16 @@ class Gripper:
         last = self._step_positions or positions
         dt = max(1, self._step_ticks) * self.h
         self._step_positions, self._step_ticks = positions, 0
+        window = self._window
+        oldest, span = (window[0], len(window) * self.substeps * self.h) if window else (last, dt)
+        window.append(positions)
         axes = {}
         # (lo, hi: the joint's stop: the solver's give at a stop is no position the joint has)
-        for (name, lo, hi, _), q, before, effort in zip(self._ranges, positions, last, self._effort_sum):
-            axes[name] = AxisState(min(max(q, lo), hi), (q - before) / dt, effort / n if measured else 0.0)
+        for (name, lo, hi, _), q, before, effort, (_, _, moving), then in zip(self._ranges, positions, last,
+                                                                             self._effort_sum, self._per_input, oldest):
+            speed = (q - before) / dt
+            axes[name] = AxisState(min(max(q, lo), hi), speed, effort / n if measured else 0.0,
+                                   (speed > moving or speed < -moving) and abs(q - then) > moving * span)
         self.state.axes = axes
         if self._resting is not None:  # resting drives rest on while each joint stays within its bounds
             for q, (lo, hi) in zip(positions, self._resting[1]):
@@ -1277,7 +1291,7 @@ class Gripper:
             goal, axis = goals[name], axes[name]
             if abs(goal - axis.actual) <= tolerance:
                 continue
-            if abs(axis.velocity) > moving or abs(self.command_position[name] - axis.actual) <= tolerance:
+            if axis.moving or abs(self.command_position[name] - axis.actual) <= tolerance:
                 return STATUS_MOVING
             if stopped is None:
                 stopped = STATUS_CLOSING_CONTACT if (goal - axis.actual) * self.closing[name] > 0 else STATUS_OPENING_CONTACT

@@ -41,7 +41,9 @@ GROUPS = (GRIPPER, FINGERS, ROBOT, TARGETS, CONTROLLER, SIM)
 
 # What the per-input outputs mean (the gripper computes them with these very numbers).
 IN_POSITION_TOLERANCE = {"m": 0.0002, "rad": 0.002}  # 0.2 mm, ~0.1 degree
-MOVING_SPEED = {"m": 0.001, "rad": 0.005}  # below this the axis counts as standing still
+MOVING_SPEED = {"m": 0.001, "rad": 0.005}  # below this the axis counts as standing still: over the last step, and
+MOVING_WINDOW = 0.05  # s: ... over the last this many seconds too (a settling grip's jitter, 0.02 mm to and fro
+# from step to step, is no motion; a joint moving on at that speed is, within a few steps)
 FORCE_UNIT = {"m": "N", "rad": "N*m"}  # a finger's force: of a prismatic or a revolute joint's servo
 
 # The robot controller's signal types (RAPID's DI/DO/AI/AO/GI/GO) as signal types.

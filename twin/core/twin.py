@@ -243,7 +243,7 @@ class Twin:
             axis = axes[name]
             out[actual_key] = axis.actual
             out[in_position_key] = abs(axis.actual - setpoint[name]) <= tolerance
-            out[moving_key] = abs(axis.velocity) > moving
+            out[moving_key] = axis.moving
             out[effort_key] = axis.effort
         fingers = g.fingers
         if fingers is not self._published_fingers:  # (the gripper keeps its fingers' states while they stand)
