@@ -310,6 +310,19 @@ def test_an_off_centre_part_pushed_by_the_first_finger_is_judged_from_the_grips_
         assert f["force"] == pytest.approx(40.0, rel=0.1)
 
 
+def test_fingers_whose_efforts_do_not_balance_fail_on_balance_naming_the_finger_at_a_stop(tmp_path, capsys):
+    # the newcomer's jaws at 40 N and 10 N: statics leaves 30 N to push the 0.28 kg block (floor friction 0.5 x 2.8 N)
+    # and the weak jaw over until a stop holds a jaw (here the strong one's range ends 0.5 mm past the block's side)
+    station = newcomer_station(tmp_path / "uneven", 40.0, extra="[gripper.joints.jaw_b]\neffort = 10.0\n")
+    code, text, report = run_check(station, tmp_path, capsys)
+    consistent_exit(code, text)
+    (line,) = [ln for ln in lines(text, "FAIL") if " grip balance: " in ln]
+    assert "(jaw_a 40 N, jaw_b 10 N)" in line, line
+    same = newcomer_station(tmp_path / "even", 40.0)
+    code, text, report = run_check(same, tmp_path, capsys)
+    assert code == 0 and " balance: " not in text, text
+
+
 def test_knuckle_fingers_are_judged_by_virtual_work_where_they_touch(tmp_path, capsys):
     # tests/grippers/knuckle_2f (its URDF's comment): at the contact (q = 0.25 rad) virtual work gives 13.09 N at the
     # distal pad and 0.215 N m about the distal joint, the finger's own: what the doctor must expect of it (not the

@@ -311,6 +311,8 @@ class Gripper:
         # pybullet_utils' client looks every function up anew on each call: the per-substep ones are bound once
         self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
         self._contact_points = client.getContactPoints
+        self._sliding: list | None = None  # (`_thrust_axis`)
+        self._palm_now = None  # the palm's pose, read after the step's physics, until the step has been sensed
         self._link_keys = {(link, uid): ((finger, uid), finger in self.revolute_fingers)
                            for link, finger in self._finger_of_link.items()
                            for uid in targets.values()}  # a contact's (finger link, target): its force's key, revolute?
@@ -1024,6 +1026,7 @@ class Gripper:
         """After a physics substep: add up the drives' applied forces; after the step's last, read the fingers'
         contact forces. While every drive stands quiet, the step's last substep alone is read (nothing moves in
         between)."""
+        self._palm_now = None
         if self._quiet and not last:
             return
         self._n += 1
@@ -1090,15 +1093,50 @@ class Gripper:
         return sum(tau[i] * axis[i] for i in range(3))
 
     def _thrust_axis(self, finger: str) -> tuple | bool:
-        """A prismatic finger's joint axis in the world, read once a step (its direction: where its link stood at the
-        last substep's start, a few microradians off). The contacts' whole force (normal and friction) along it is
-        what its drive carries in statics, whatever way they face (a V-groove's flanks, a part turned in the grip),
-        as a revolute finger's torque (`_torque`). False for a finger on a fixed joint: its contacts' normal force."""
-        joint = self.finger_joint[finger]
-        kind, axis = self._joint_kind(joint)
-        frame = kind == pybullet.JOINT_PRISMATIC and _rotate(self.client.getLinkState(self.body, joint)[5], axis)
-        self._joint_frames[finger] = frame
-        return frame
+        """A prismatic finger's joint axis in the world, worked out once a step for every prismatic finger: the
+        contacts' whole force (normal and friction) along it is what its drive carries in statics, whatever way they
+        face (a V-groove's flanks, a part turned in the grip), as a revolute finger's torque (`_torque`). An axis
+        that only slides relative to the palm is the palm's rotation of a fixed one: one pybullet query a step for
+        all, the palm's pose, which the slip watch then reads too. False for a finger on a fixed joint: its contacts'
+        normal force."""
+        sliding = self._sliding
+        if sliding is None:
+            sliding = self._sliding = self._sliding_axes()
+        frames = self._joint_frames
+        if sliding:
+            pose = self._palm_now = self._base_pose()
+            m = pybullet.getMatrixFromQuaternion(pose[1])
+            for f, joint, axis, in_palm in sliding:
+                if in_palm:
+                    x, y, z = axis
+                    frames[f] = (m[0] * x + m[1] * y + m[2] * z, m[3] * x + m[4] * y + m[5] * z,
+                                 m[6] * x + m[7] * y + m[8] * z)
+                else:  # (a joint a revolute one turns relative to the palm: its own link's frame)
+                    frames[f] = _rotate(self.client.getLinkState(self.body, joint)[5], axis)
+        return frames.setdefault(finger, False)
+
+    def _sliding_axes(self) -> list[tuple]:
+        """Per finger on a prismatic joint: (finger, joint, axis, True) with its axis in the palm's frame where only
+        prismatic and fixed joints lie between them, else (finger, joint, its axis in its own frame, False)."""
+        c, body, out = self.client, self.body, []
+        palm = c.getMatrixFromQuaternion(self._base_pose()[1])
+        for f in self.finger_links:
+            joint = self.finger_joint[f]
+            kind, axis = self._joint_kind(joint)
+            if kind != pybullet.JOINT_PRISMATIC:
+                continue
+            link, rigid = c.getJointInfo(body, joint)[16], True
+            while link not in (self.palm_link, -1):
+                info = c.getJointInfo(body, link)
+                rigid = rigid and info[2] in (pybullet.JOINT_PRISMATIC, pybullet.JOINT_FIXED)
+                link = info[16]
+            if rigid and link == self.palm_link:
+                w = _rotate(c.getLinkState(body, joint, computeForwardKinematics=True)[5], axis)
+                out.append((f, joint, tuple(palm[i] * w[0] + palm[3 + i] * w[1] + palm[6 + i] * w[2]
+                                            for i in range(3)), True))
+            else:
+                out.append((f, joint, axis, False))
+        return out
 
     def _joint_kind(self, joint: int) -> tuple[int, tuple]:
         """A joint's type and its axis in its own frame (read from pybullet once)."""
@@ -1224,6 +1262,7 @@ class Gripper:
             self._opened_since_grip, self._lost_steps = False, 0
         self.state.gripped = newly
         self._watch_slip()
+        self._palm_now = None
 
     def _pressed_by_all(self, threshold: dict[str, float], only: str | None = None) -> list[str]:
         """The targets (station order) every finger presses on with at least its threshold force."""
@@ -1287,7 +1326,7 @@ class Gripper:
         pushing; else at the setpoint."""
         stopped = None
         goals = self._hold if self._hold is not None else self.setpoint
-        for name, tolerance, moving in self._servo_limits[finger]:
+        for name, tolerance, _ in self._servo_limits[finger]:
             goal, axis = goals[name], axes[name]
             if abs(goal - axis.actual) <= tolerance:
                 continue
@@ -1299,6 +1338,8 @@ class Gripper:
 
     # -- slip -----------------------------------------------------------------------------------------------
     def _base_pose(self):
+        if self._palm_now is not None:  # (read after this step's physics already: `_thrust_axis`)
+            return self._palm_now
         c = self.client
         if self.palm_link == -1:
             return c.getBasePositionAndOrientation(self.body)

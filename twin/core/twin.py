@@ -15,7 +15,7 @@ from pathlib import Path
 from .errors import MotionError, ObjectError, SignalError, StationError
 from .gripper import Gripper
 from .mechanism import Mechanism, load_mechanism
-from .signal_table import IN_POSITION_TOLERANCE, MOVING_SPEED, twin_signals
+from .signal_table import IN_POSITION_TOLERANCE, twin_signals
 from .device import Device
 from .signals import INPUT, OUTPUT, SignalSpec
 from .station import Station, load_station
@@ -239,7 +239,7 @@ class Twin:
         out["GrippedPart"] = g.gripped
         out["slip"] = g.slip
         axes = g.axes
-        for name, actual_key, in_position_key, moving_key, effort_key, tolerance, moving in self._axis_keys:
+        for name, actual_key, in_position_key, moving_key, effort_key, tolerance in self._axis_keys:
             axis = axes[name]
             out[actual_key] = axis.actual
             out[in_position_key] = abs(axis.actual - setpoint[name]) <= tolerance
@@ -284,7 +284,7 @@ class Twin:
     def _index_outputs(self) -> None:
         """The output names published at every step, spelled out once (not formatted anew at every step)."""
         self._axis_keys = [(i.name, f"{i.name}.actual", f"{i.name}.in_position", f"{i.name}.moving",
-                            f"{i.name}.effort", IN_POSITION_TOLERANCE[i.unit], MOVING_SPEED[i.unit])
+                            f"{i.name}.effort", IN_POSITION_TOLERANCE[i.unit])
                            for i in self.mechanism.inputs]
         self._finger_keys = [(name, f"{name}.contact", f"{name}.force", f"{name}.status")
                              for name in self.gripper.state.fingers]

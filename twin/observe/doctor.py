@@ -27,6 +27,7 @@ from pathlib import Path
 from twin.core.errors import MotionError
 from twin.core.bullet import pybullet
 from twin.core.geometry import Pose, cross
+from twin.core.signal_table import IN_POSITION_TOLERANCE
 from twin.core.world import STEEL_DENSITY as STEEL, link_volume
 
 PASS, WARN, FAIL, INFO = "PASS", "WARN", "FAIL", "INFO"
@@ -895,6 +896,33 @@ class Doctor:
             self.check(FAIL, where, "grip", "capacity", text + " (< 1x: cannot hold it)")
         if result.gripped_step is None:
             self.check(WARN, where, "grip", "doGripped", "never reported the part gripped")
+        self.judge_balance(where, res, result)
+
+    def judge_balance(self, where: str, res: dict, result) -> None:
+        """A FAIL where the drives' efforts do not balance across the part and it walks in the grip, or a finger stands
+        at an end of its range while pressing: the stronger push the part, and the weaker, until a stop holds a finger
+        (why the grip's status, noise, push and creep lines fail, and a force reads what the others push)."""
+        tw, at_end = self.twin, []
+        expected = {f: self.g.chain_effort(r.drive) * self.linkage_share(f, r.drive, list(res))
+                    for f, r in res.items() if r.drive is not None}
+        if not expected or max(expected.values()) <= (1 + FORCE_TOLERANCE) * min(expected.values()):
+            return
+        for f, r in res.items():
+            d = r.drive
+            if r.onset_step is None or d is None:
+                continue
+            inp, way, q = self.mech.input(d), self.g.closing[d], float(tw.read(f"{d}.actual"))
+            for end, which in ((inp.min, "open" if way > 0 else "closed"), (inp.max, "closed" if way > 0 else "open")):
+                if abs(q - end) <= IN_POSITION_TOLERANCE[inp.unit]:
+                    at_end.append(f"{f} stands at its range's {which} end")
+        walked = [] if result.held_creep is None or result.held_creep < HELD_CREEP else [
+            f"the part walked {_fmt_len(result.held_creep)} in the hold"]
+        if at_end or walked:
+            unit = {f: "N m" if f in self.g.revolute_fingers else "N" for f in expected}
+            efforts = ", ".join(f"{f} {e:.4g} {unit[f]}" for f, e in expected.items())
+            self.check(FAIL, where, "grip", "balance",
+                       f"the drives' efforts do not balance across the part ({efforts}): the stronger push it, and the "
+                       f"weaker, until a stop holds a finger ({'; '.join(at_end + walked)})")
 
     def judge_slip(self, name: str, where: str, when: str) -> None:
         """`slip` must say whether the part moved more than slip_distance relative to the gripper since the grip
