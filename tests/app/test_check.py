@@ -275,6 +275,7 @@ def test_a_ram_pressing_a_part_onto_an_anvil_is_closed_towards_it_and_judged_wit
     (f,) = grip(report, "block", "outside")["fingers"]
     assert f["contact_geometry"] == pytest.approx(0.060, abs=0.0002)
     assert f["force"] == pytest.approx(51.96, abs=0.5)
+    assert f["expected_force"] == pytest.approx(50.0 + 0.2 * G, abs=0.01)  # what the doctor judges it against
     assert [run[0] for run in f["status"]][-1] == 2
 
 

@@ -498,3 +498,23 @@ def test_knuckles_and_a_ram_close_on_their_parts_where_the_geometry_says():
         twin.step(round(1.5 / twin.dt))
         assert twin.read("ram.actual") == pytest.approx(0.060, abs=0.00005)
         assert twin.read("ram.force") == pytest.approx(51.96, abs=0.5)
+
+
+def test_jaws_of_unequal_speeds_leave_the_part_where_the_grip_closed_it_and_keep_to_their_velocity_limits():
+    # tests/grippers/uneven_speeds (its URDF's comment): the fast jaw pushes the cube 7.8 mm over and stands 3.2 mm
+    # short of its range's end when the slow one meets it; from then on equal efforts hold the cube where it is
+    limits = {"jaw_l": 0.08, "jaw_r": 0.01}  # m/s: the URDF's, and the station's for jaw_r
+    with Twin.from_station(GRIPPERS["uneven_speeds"]) as twin:
+        grip, closed = close_on_part(twin, "uneven_speeds")
+        start = twin.object_pose("cube")[0][0]
+        before = {j: twin.read(f"{j}.actual") for j in limits}
+        for _ in range(40):
+            twin.step()
+            for j, v in limits.items():
+                q = twin.read(f"{j}.actual")
+                assert abs(q - before[j]) <= 1.05 * v * twin.dt, (j, twin.step_count)
+                before[j] = q
+        assert abs(twin.object_pose("cube")[0][0] - start) < 0.0005
+        for f in grip.force:
+            assert twin.read(f"{f}.status") == 2
+            assert twin.read(f"{f}.force") == pytest.approx(50.0, rel=0.1)

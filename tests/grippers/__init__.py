@@ -16,7 +16,8 @@
 - `knuckle_2f`: two fingers of two knuckles each (a driven proximal joint, a mimic distal one), 1 N m, on a 90 g can;
 - `ram_press`: one finger, a 50 N ram moving down, pressing a 200 g block onto an anvil (a fixture);
 - `light_jaws_heavy_block`: 20 g jaws at 300 N on a 4 kg steel block (the part 200 times heavier than either jaw);
-- `watch_2n`: a watchmaker's 2 N jaws of 1.4 g with a 5 mm stroke on a 1.7 g wheel, their range ending 1 mm past it.
+- `watch_2n`: a watchmaker's 2 N jaws of 1.4 g with a 5 mm stroke on a 1.7 g wheel, their range ending 1 mm past it;
+- `uneven_speeds`: 50 N jaws at 80 and 10 mm/s on a centred 64 g cube, which the fast one pushes 7.8 mm over.
 
 `GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
 grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
@@ -28,7 +29,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
          "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh", "heavy_jaws_light_can", "round_pads",
-         "angular_bare", "knuckle_2f", "ram_press", "light_jaws_heavy_block", "watch_2n")
+         "angular_bare", "knuckle_2f", "ram_press", "light_jaws_heavy_block", "watch_2n",
+         "uneven_speeds")
 GRIPPERS = {name: HERE / name for name in NAMES}
 
 
@@ -63,6 +65,7 @@ GRIPS = {  # every finger closed to its range's end: well past the part, so each
     "ram_press": Grip("block", {"ram": 0.08}, {"ram": 51.96}),  # (the drive's 50 N and the ram's weight)
     "light_jaws_heavy_block": Grip("block", {"jaw_l": 0.05, "jaw_r": 0.05}, {"jaw_l": 300.0, "jaw_r": 300.0}),
     "watch_2n": Grip("wheel", {"jaw_l": 0.005, "jaw_r": 0.005}, {"jaw_l": 2.0, "jaw_r": 2.0}),
+    "uneven_speeds": Grip("cube", {"jaw_l": 0.046, "jaw_r": 0.046}, {"jaw_l": 50.0, "jaw_r": 50.0}),
 }
 
 

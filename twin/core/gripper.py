@@ -256,7 +256,7 @@ class Gripper:
         self._stalled: dict[str, float | None] = {}  # input -> the direction it presses in, while stalled on a part
         # inputs stalled past their range's end, sent there: an end that lies closer past the part than the drive's
         # full-force error (a short stroke) is pressed past, with the effort, not with what the spring gives there
-        self._past: set[str] = set()
+        self._past: dict[str, float] = {}  # (input -> the way it presses)
         self._new_goal: set[str] = set()  # inputs given a setpoint since their drive last ran
         self._hold: dict[str, float] | None = None
         self._constraint: int | None = None
@@ -700,7 +700,7 @@ class Gripper:
             before = command[name]
             pressing = presses[name]  # a finger it moves pressed on a part in the last step
             short = False  # a drive in one of the states a cell stands in, which the loop below gives in short
-            if pressing and not in_series and name not in turned:
+            if pressing and not in_series and name not in turned and name not in past:
                 # pressing on a part, with no new goal: its command at its goal (a setpoint within full force past the
                 # part; pressing through drives in series, while those its force loads stand at theirs: the ring rig's
                 # carriage and fine axis carrying the ring), or, alone, stalled short of it on a part that holds: the
@@ -739,6 +739,7 @@ class Gripper:
                 continue
             if name in turned:
                 turned.discard(name)
+                past.pop(name, None)
                 if (g - actual) * (before - actual) < 0.0:
                     before = actual  # a new goal the other way: the drive turns at once, from where the joint is
                     stalled[name] = None
@@ -755,15 +756,19 @@ class Gripper:
             else:
                 way = None
                 rate = velocity
-                if ((before - actual) * (g - actual) > 0.0 and pressing
-                        and (moved if g > actual else -moved) < held_speed):
+                side = past.get(name)
+                aim = g if side is None else actual + side * latch  # (pressing past its range's end: to full force)
+                if ((before - actual) * (aim - actual) > 0.0 and pressing
+                        and (moved if aim > actual else -moved) < held_speed):
                     # pressing on a part that holds the finger (held: the joint moved slower than HELD_SHARE of
                     # its velocity limit the way its goal lies, last substep): full force within the rise time (a
                     # part that gives way is pushed at the velocity limit, as a real servo's speed loop does, not
                     # run over by the command)
                     rate = max(rate, rise_rate)
                 run = rate * h  # (the command moved towards its goal by at most that, landing exactly on it)
-                target = g if abs(g - before) <= run else before + (run if g > before else -run)
+                target = aim if abs(aim - before) <= run else before + (run if aim > before else -run)
+                if side is not None and target == aim:
+                    way = side  # (at full force past its range's end: stalled there)
             # the command runs ahead of a blocked joint no further than full force: a new setpoint acts at once. A
             # drive others press through (a fine axis under its carriage) keeps a command that stands at its goal:
             # pushed off it, it pushes back with its effort, and is not dragged along into a stall of its own
@@ -782,14 +787,13 @@ class Gripper:
                   and (g >= ends[name][1] - PAST_GAP[units[name]] if g > actual
                        else g <= ends[name][0] + PAST_GAP[units[name]])):
                 # held by a part short of its range's end, sent there (closed all the way), the end closer past the
-                # part than full force (a short stroke): it presses past the end, with its effort as any stalled drive
-                # (the spring at the end would give a fraction of it: a setpoint within the range presses with what
-                # the spring gives there); it aims at its goal again once the part gives way to there
-                way = 1.0 if g > actual else -1.0
-                target = actual + way * latch
-                past.add(name)
-            if way is None or (g - target) * way > 0.0 or (g - actual) * way <= PAST_GAP[units[name]]:
-                past.discard(name)
+                # part than full force (a short stroke): from the next substep its command runs on past the end, at the
+                # force's rise rate, and stalls at full force as any drive (the spring at the end would give a fraction
+                # of it: a setpoint within the range presses with what the spring gives there); it aims at its goal
+                # again once the part gives way to within its in-position tolerance of it
+                past[name] = 1.0 if g > actual else -1.0
+            if name in past and (not pressing or (g - actual) * past[name] <= PAST_GAP[units[name]]):
+                del past[name]
             stalled[name] = way
             command[name] = target
             error = target - actual

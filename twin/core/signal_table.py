@@ -129,8 +129,8 @@ def gripper_signals(station: Station, mechanism: Mechanism) -> list[SignalSpec]:
     sig.append(SignalSpec("GrippedPart", OUTPUT, ENUM, description="the held target (none, or one of the target group)",
                           choices=("",) + targets))
     sig.append(SignalSpec("slip", OUTPUT, BOOL, description=f"the gripped part moved more than "
-                          f"{st.gripper.slip_distance * 1000:g} mm relative to the gripper's base since it was "
-                          "gripped (held until the next grip)"))
+                          f"{st.gripper.slip_distance * 1000:g} mm relative to the palm (the link every finger hangs from) "
+                          "since it was gripped (held until the next grip)"))
     for inp in m.inputs:
         sig.append(SignalSpec(f"{inp.name}.actual", OUTPUT, FLOAT, inp.unit, inp.min, inp.max,
                               f"actual position of joint {inp.joint}"))
@@ -145,8 +145,8 @@ def gripper_signals(station: Station, mechanism: Mechanism) -> list[SignalSpec]:
         touch = "touches" if st.gripper.grip == "attach" else "touches and presses on"
         sig.append(SignalSpec(f"{f.name}.contact", OUTPUT, BOOL, group=FINGERS, description=f"finger {f.name} {touch} a target"))
         sig.append(SignalSpec(f"{f.name}.force", OUTPUT, FLOAT, unit, 0.0, None, group=FINGERS,
-                              description=f"normal force of finger {f.name} on target objects (measured"
-                              + (", as torque about its joint)" if unit == "N*m" else ")")))
+                              description=f"force of finger {f.name}'s contacts on target objects (measured"
+                              + (", as torque about its joint)" if unit == "N*m" else ", along its joint's axis)")))
         sig.append(SignalSpec(f"{f.name}.status", OUTPUT, INT, "", 0, 3, group=FINGERS,
                               description=f"finger {f.name}'s object status: 0 moving, 1 stopped by contact while opening, "
                               "2 stopped by contact while closing, 3 at the setpoint"))

@@ -81,6 +81,7 @@ class FingerResult:
     force: float | None = None  # mean force while pressing (N or N*m)
     force_range: tuple | None = None
     expected_force: float | None = None
+    weight_along: float = 0.0  # N: of that, the weight of what its drive moves, along its closing direction
     normal_force: float | None = None  # mean sum of the contact normal forces on the part (N)
     penetration: float | None = None  # m, >= 0: the deepest overlap of the nominal shapes while pressing (into the part)
     closest: float | None = None  # m: their smallest signed distance then (> 0: apart, < 0: overlapping by -closest)
@@ -803,11 +804,33 @@ class Doctor:
             r.expected_force = g.chain_effort(d) * self.linkage_share(f, d, fingers)  # the weakest in its chain
             if d in g.rigid_linkages:  # knuckles in series: what reaches the finger depends on where it touches
                 r.expected_force = self.knuckle_force(f, d, name, g.chain_effort(d)) or r.expected_force
+            r.weight_along = self.weight_along(f, d)
+            r.expected_force += r.weight_along
             r.short_of_goal = abs(goal[d] - float(tw.read(f"{d}.actual")))
         result.weight = self.weight(name)
         result.capacity = mu * sum(r.normal_force for r in res.values())
         self.judge(where, want, status, res, moving, result, mu)
         self.judge_slip(name, where, "the hold")
+
+    def weight_along(self, finger: str, drive: str) -> float:
+        """The weight of what a prismatic finger's own drive moves, along its closing direction (N): a ram pressing
+        down adds its weight to its drive's effort (statics); 0 where the drive moves more than this finger (a
+        linkage, a lift) or turns it."""
+        g, c, body = self.g, self.c, self.body
+        movers = g._link_mover.get(drive, {})
+        others = set().union(*(set(g.finger_links[f]) for f in g.finger_links if f != finger))
+        if self.unit[drive] != "m" or not movers or others & set(movers) or any(m != 1.0 for _, m in movers.values()):
+            return 0.0
+        mass = sum(c.getDynamicsInfo(body, link)[0] for link in movers)
+        _, axis = g._joint_frame(g.joint[drive])
+        return mass * g.closing[drive] * sum(a * v for a, v in zip(axis, self.twin.station.gravity))
+
+    @staticmethod
+    def weight_note(r: FingerResult, unit: str) -> str:
+        if not r.weight_along:
+            return ""
+        return (f" ({r.expected_force - r.weight_along:.4g} {unit} of its drive's, "
+                f"{'and' if r.weight_along > 0 else 'less'} {abs(r.weight_along):.4g} {unit} of the weight it moves)")
 
     def range_hint(self, r: FingerResult) -> str:
         """Why a finger presses short of its effort where its drive's range ends too close past the part: a stalled
@@ -857,7 +880,8 @@ class Doctor:
             ok = abs(ratio - 1) <= FORCE_TOLERANCE
             self.check(PASS if ok else FAIL, where, f, "force",
                        f"{r.force:.4g} {u} (from {r.force_range[0]:.4g} to {r.force_range[1]:.4g}) against "
-                       f"{r.expected_force:.4g} {u} of effort: {ratio:.3f} (within {FORCE_TOLERANCE:.0%})"
+                       f"{r.expected_force:.4g} {u} of effort{self.weight_note(r, u)}: {ratio:.3f} (within "
+                       f"{FORCE_TOLERANCE:.0%})"
                        + ("" if ok or ratio > 1 else self.range_hint(r)))
             if r.penetration is None:
                 self.check(WARN, where, f, "penetration", "not measured (the finger's shapes)")
