@@ -17,7 +17,8 @@
 - `ram_press`: one finger, a 50 N ram moving down, pressing a 200 g block onto an anvil (a fixture);
 - `light_jaws_heavy_block`: 20 g jaws at 300 N on a 4 kg steel block (the part 200 times heavier than either jaw);
 - `watch_2n`: a watchmaker's 2 N jaws of 1.4 g with a 5 mm stroke on a 1.7 g wheel, their range ending 1 mm past it;
-- `uneven_speeds`: 50 N jaws at 80 and 10 mm/s on a centred 64 g cube, which the fast one pushes 7.8 mm over.
+- `uneven_speeds`: 50 N jaws at 80 and 10 mm/s on a centred 64 g cube, which the fast one pushes 7.8 mm over;
+- `arm_block_2kg`: two 80 N jaws on the shipped arm holding a 1.98 kg steel block by its sides (3.3 times its weight).
 
 `GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
 grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
@@ -30,7 +31,7 @@ HERE = Path(__file__).resolve().parent
 NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
          "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh", "heavy_jaws_light_can", "round_pads",
          "angular_bare", "knuckle_2f", "ram_press", "light_jaws_heavy_block", "watch_2n",
-         "uneven_speeds")
+         "uneven_speeds", "arm_block_2kg")
 GRIPPERS = {name: HERE / name for name in NAMES}
 
 

@@ -823,7 +823,8 @@ class Doctor:
             return 0.0
         mass = sum(c.getDynamicsInfo(body, link)[0] for link in movers)
         _, axis = g._joint_frame(g.joint[drive])
-        return mass * g.closing[drive] * sum(a * v for a, v in zip(axis, self.twin.station.gravity))
+        along = mass * g.closing[drive] * sum(a * v for a, v in zip(axis, self.twin.station.gravity))
+        return along if abs(along) > 1e-6 * g.drives[drive].effort else 0.0  # (a level drive: none)
 
     @staticmethod
     def weight_note(r: FingerResult, unit: str) -> str:
@@ -854,6 +855,7 @@ class Doctor:
         # the grip closes when its last finger touches: one that touched first pushes an off-centre part over to the
         # others, moving (status 0), and stalls only once they hold it
         closed = max((r.onset_step for r in res.values() if r.onset_step is not None), default=None)
+        unbalanced = self.unbalanced(res)
         for f, r in res.items():
             if r.onset_step is None:
                 self.check(FAIL, where, f, "contact", f"never touched the part (geometry: contact at "
@@ -882,7 +884,7 @@ class Doctor:
                        f"{r.force:.4g} {u} (from {r.force_range[0]:.4g} to {r.force_range[1]:.4g}) against "
                        f"{r.expected_force:.4g} {u} of effort{self.weight_note(r, u)}: {ratio:.3f} (within "
                        f"{FORCE_TOLERANCE:.0%})"
-                       + ("" if ok or ratio > 1 else self.range_hint(r)))
+                       + ("" if ok or ratio > 1 or unbalanced else self.range_hint(r)))
             if r.penetration is None:
                 self.check(WARN, where, f, "penetration", "not measured (the finger's shapes)")
             else:
@@ -922,14 +924,21 @@ class Doctor:
             self.check(WARN, where, "grip", "doGripped", "never reported the part gripped")
         self.judge_balance(where, res, result)
 
+    def unbalanced(self, res: dict) -> dict:
+        """The fingers' efforts (finger -> N or N m) where they differ by more than the force tolerance, else {}."""
+        expected = {f: self.g.chain_effort(r.drive) * self.linkage_share(f, r.drive, list(res))
+                    for f, r in res.items() if r.drive is not None}
+        if not expected or max(expected.values()) <= (1 + FORCE_TOLERANCE) * min(expected.values()):
+            return {}
+        return expected
+
     def judge_balance(self, where: str, res: dict, result) -> None:
         """A FAIL where the drives' efforts do not balance across the part and it walks in the grip, or a finger stands
         at an end of its range while pressing: the stronger push the part, and the weaker, until a stop holds a finger
         (why the grip's status, noise, push and creep lines fail, and a force reads what the others push)."""
         tw, at_end = self.twin, []
-        expected = {f: self.g.chain_effort(r.drive) * self.linkage_share(f, r.drive, list(res))
-                    for f, r in res.items() if r.drive is not None}
-        if not expected or max(expected.values()) <= (1 + FORCE_TOLERANCE) * min(expected.values()):
+        expected = self.unbalanced(res)
+        if not expected:
             return
         for f, r in res.items():
             d = r.drive
