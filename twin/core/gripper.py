@@ -301,7 +301,7 @@ class Gripper:
                               for name in self.names]  # each joint's share of its drive's force
         self._motor_ids = self._joint_ids + [joint for _, joint, _, _ in self._linkage]
         self._mesh_links: set[int] = set()
-        for links in self.finger_links.values():
+        for finger, links in self.finger_links.items():
             for link in links:
                 client.changeDynamics(body, link, lateralFriction=spec.friction)
                 client.changeDynamics(body, link, collisionMargin=COLLISION_MARGIN)  # (in one call pybullet drops the friction)
@@ -312,10 +312,12 @@ class Gripper:
                 # (uniform pressure over a patch of radius a), which pybullet's few contact points per face do not
                 # give: a 2 kg block between 80 N pads turned 15 degrees about the jaws' axis in a 1 m/s lift. a: half
                 # the pad's middle size (its face across the thickness); pybullet multiplies this by the part's
-                # friction, as it does the lateral friction
-                lo, hi = client.getAABB(body, link)
-                middle = sorted(h - l for l, h in zip(lo, hi))[1]
-                client.changeDynamics(body, link, spinningFriction=2.0 / 3.0 * middle / 2 * spec.friction)
+                # friction, as it does the lateral friction. A sliding jaw's flat pad: a lever's pad rolls over the part
+                # as it closes, touching along a line (the PR2's mesh fingers on a peg flickered with it)
+                if finger not in self.revolute_fingers:
+                    lo, hi = client.getAABB(body, link)
+                    middle = sorted(h - l for l, h in zip(lo, hi))[1]
+                    client.changeDynamics(body, link, spinningFriction=2.0 / 3.0 * middle / 2 * spec.friction)
         # pybullet_utils' client looks every function up anew on each call: the per-substep ones are bound once
         self._joint_states, self._motors = client.getJointStates, client.setJointMotorControlArray
         self._contact_points = client.getContactPoints
