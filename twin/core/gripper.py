@@ -241,7 +241,9 @@ class Gripper:
         self._derive_drives(stiffness_given)
         self.rise_time = spec.force_rise_time or FORCE_RISE_TIME  # s (docs/station-format.md, "Drives")
         self._constants: list[tuple] | None = None  # what `drive` asks of each drive at every substep, formed once
-        self.effort_notes = self._defaulted_limits(defaulted) + self._unreachable_efforts()
+        # one line per drive limit the station runs with but does not give, or cannot reach: (the limit, the line)
+        self.limit_notes = self._defaulted_limits(defaulted) + [("effort", n) for n in self._unreachable_efforts()]
+        self.effort_notes = [note for _, note in self.limit_notes]
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
         self.grip_force = {f: spec.grip_force if spec.grip_force is not None
@@ -471,17 +473,19 @@ class Gripper:
         self.spring_sweeps = max((self.drives[n].stiffness * h * h / self.drives[n].own for n in own_drives
                                   if not self.drives[n].rigid), default=0.0)
 
-    def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[str]:
+    def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[tuple[str, str]]:
         """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,
         as exporters leave them) nor the station gives (`defaulted`: (input, "velocity" or "effort")): the default the
-        drive runs with, and where to give the real one."""
-        notes = []
+        drive runs with, and where to give the real one: (the limit, the line)."""
+        notes, lines = [], []
         for inp, what in defaulted:
             value = getattr(self.drives[inp.name], what)
             unit = f"{inp.unit}/s" if what == "velocity" else "N" if inp.unit == "m" else "N m"
-            _warn_once(notes, f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing or "
-                              f"0): its drive runs with {value:g} {unit}; give the real one in the URDF's <limit "
-                              f"{what}=...> or in [gripper.joints.{inp.name}] {what}")
+            line = (f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing or 0): its "
+                    f"drive runs with {value:g} {unit}; give the real one in the URDF's <limit {what}=...> or in "
+                    f"[gripper.joints.{inp.name}] {what}")
+            _warn_once(lines, line)
+            notes.append((what, line))
         return notes
 
     def _unreachable_efforts(self) -> list[str]:

@@ -522,8 +522,8 @@ class Doctor:
             return self.report
         if not self.twin.read("Active"):
             self.twin.write("Active", True)  # a gripper that is not always active follows its setpoints once told to
-        for note in self.g.effort_notes:  # a placeholder effort: the force check below cannot pass, and says so
-            self.check(WARN, "station", "drive", "effort", note)
+        for what, note in self.g.limit_notes:  # a drive limit the URDF leaves out, or a placeholder effort (the force
+            self.check(WARN, "station", "drive", what, note)  # check below cannot pass, and says so)
         for link, measure, note in self.twin.world.urdf_fixes:  # URDF data replaced: the real values are wanted
             self.check(WARN, "station", link, measure, note)
         self.rest()
