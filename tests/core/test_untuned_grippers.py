@@ -548,3 +548,18 @@ def test_a_block_gripped_with_three_times_its_weight_stays_in_the_jaws_through_b
             assert not twin.read("slip")
         for jaw in ("jaw_l", "jaw_r"):
             assert twin.read(f"{jaw}.force") == pytest.approx(80.0, rel=0.1)
+
+
+def test_a_v_groove_jaw_reads_what_its_drive_carries_along_its_axis_not_its_flanks_normal_forces_summed():
+    # tests/grippers/vgroove_pin (its URDF's comment): the jaws meet the pin at q = 0.02586; each drive carries 20 N
+    # along its axis, while the flanks' normal forces, at 45 degrees to it, sum to about 20 / cos(45 deg) = 28 N
+    with Twin.from_station(GRIPPERS["vgroove_pin"]) as twin:
+        grip, _ = close_on_part(twin, "vgroove_pin")
+        twin.step(SETTLE_STEPS)
+        c, body, pin = twin.world.client, twin.world.machine, twin.world.body_ids["pin"]
+        for f in grip.force:
+            assert twin.read(f"{f}.actual") == pytest.approx(0.02586, abs=0.0003)
+            normals = sum(pt[9] for link in twin.gripper.finger_links[f]
+                          for pt in c.getContactPoints(body, pin, linkIndexA=link))
+            assert normals > 1.15 * 20.0  # (the flanks press harder than the drive pushes)
+            assert twin.read(f"{f}.force") == pytest.approx(20.0, rel=0.1)

@@ -18,7 +18,8 @@
 - `light_jaws_heavy_block`: 20 g jaws at 300 N on a 4 kg steel block (the part 200 times heavier than either jaw);
 - `watch_2n`: a watchmaker's 2 N jaws of 1.4 g with a 5 mm stroke on a 1.7 g wheel, their range ending 1 mm past it;
 - `uneven_speeds`: 50 N jaws at 80 and 10 mm/s on a centred 64 g cube, which the fast one pushes 7.8 mm over;
-- `arm_block_2kg`: two 80 N jaws on the shipped arm holding a 1.98 kg steel block by its sides (3.3 times its weight).
+- `arm_block_2kg`: two 80 N jaws on the shipped arm holding a 1.98 kg steel block by its sides (3.3 times its weight);
+- `vgroove_pin`: 20 N jaws whose pads are 90 degree V-grooves of two flanks, on a 20 mm pin.
 
 `GRIPPERS` maps each name to its folder (what `twin check` and `Twin.from_station` take); `GRIPS` says how each
 grips its part: the setpoints that close every finger past it (so each presses with its whole drive effort), and
@@ -31,7 +32,7 @@ HERE = Path(__file__).resolve().parent
 NAMES = ("newcomer_2f", "newcomer_2f_box", "newcomer_2f_steel", "parallel_200n", "revolute_chuck",
          "revolute_chuck_bore", "light_5n", "sloppy_inertia", "pr2_mesh", "heavy_jaws_light_can", "round_pads",
          "angular_bare", "knuckle_2f", "ram_press", "light_jaws_heavy_block", "watch_2n",
-         "uneven_speeds", "arm_block_2kg")
+         "uneven_speeds", "arm_block_2kg", "vgroove_pin")
 GRIPPERS = {name: HERE / name for name in NAMES}
 
 
@@ -67,6 +68,8 @@ GRIPS = {  # every finger closed to its range's end: well past the part, so each
     "light_jaws_heavy_block": Grip("block", {"jaw_l": 0.05, "jaw_r": 0.05}, {"jaw_l": 300.0, "jaw_r": 300.0}),
     "watch_2n": Grip("wheel", {"jaw_l": 0.005, "jaw_r": 0.005}, {"jaw_l": 2.0, "jaw_r": 2.0}),
     "uneven_speeds": Grip("cube", {"jaw_l": 0.046, "jaw_r": 0.046}, {"jaw_l": 50.0, "jaw_r": 50.0}),
+    # (along each jaw's axis: its flanks' normal forces, at 45 degrees to it, sum to more)
+    "vgroove_pin": Grip("pin", {"jaw_l": 0.035, "jaw_r": 0.035}, {"jaw_l": 20.0, "jaw_r": 20.0}),
 }
 
 
