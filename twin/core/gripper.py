@@ -78,8 +78,8 @@ HOLD_FRACTION = 0.02  # the force a drive may use near zero error (damps a free 
 PUSH_SPEEDUP = 20.0  # how much faster than its velocity limit a held drive asks to move
 PAST_REACH = 3.0  # ... if its full-force error is at most this many times its joint's range: beyond, the effort is a
 # placeholder (1000 N m on a 0.1 kg finger), and the finger presses with what its spring gives (a warning says so)
-PAST_GAP = IN_POSITION_TOLERANCE  # a drive held by a part further than this short of a goal that lies closer past it
-# than its full-force error presses past its goal (`Gripper._past`); nearer its goal, it is at its setpoint
+PAST_GAP = IN_POSITION_TOLERANCE  # a drive held by a part further than this short of its range's end, sent there,
+# presses past it where it lies closer past the part than full force (`Gripper._past`); nearer, it is at its setpoint
 FACING = 0.9999  # a contact whose normal lies within 14 mrad of a prismatic finger's axis: its friction's share of
 # the force along the axis is left out (its friction acts across the axis within 1.4 %), the rest is summed
 LATCH_FRACTION = 0.975  # a drive pressing with this share of its full-force error stalls: its command waits there
@@ -503,7 +503,8 @@ class Gripper:
             _warn_once(notes, f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest "
                               f"position loop the {self.h * 1000:g} ms substep keeps stable for what it moves "
                               f"({d.stiffness:.4g} {k}) needs {d.full_error:.3g} {self.unit[name]} of following error for "
-                              f"it, more than {PAST_REACH:g} times the joint's range ({hi - lo:.3g} {self.unit[name]}): a finger presses with "
+                              f"it, more than {PAST_REACH:g} times the joint's range ({hi - lo:.3g} {self.unit[name]}): a "
+                              f"finger presses with "
                               f"at most {d.stiffness * (hi - lo):.3g} {u}. A placeholder? Give the drive's real effort in "
                               f"[gripper.joints.{name}] effort")
         return notes
@@ -924,8 +925,9 @@ class Gripper:
         limit, whether it presses through drives in series (and which hold others), whether it has springs in series,
         its own links' share of its mass, and the drive's rigidity, stiffness, damping and holding force."""
         out = []
-        # the drives that may press past a goal lying closer past the part than their full force (`_past`): each alone
-        # on its finger (no drives in series), not rigid, its effort within reach of its range (PAST_REACH)
+        # the drives that may press past their range's end where it lies closer past the part than full force
+        # (`_past`): alone on its finger (no drives in series), not rigid, its effort within reach of its range
+        # (PAST_REACH)
         self._pressing_past = {name for name, d in self.drives.items()
                                if not (d.rigid or name in self._series_loads or name in self._series_holders
                                        or self._series[name] > 1)
@@ -1081,7 +1083,7 @@ class Gripper:
             key, revolute = key
             if revolute:
                 force = abs(self._torque(key[0], pt))
-            else:  # the contact's whole force along the finger's joint axis (`_thrust`, here in line: every contact)
+            else:  # the contact's whole force along the finger's joint axis (`_thrust_axis`; in line: every contact)
                 frame = axes.get(key[0])
                 if frame is None:
                     frame = self._thrust_axis(key[0])
