@@ -179,6 +179,8 @@ stiffness = {effort / full_error}
         said = re.search(r"its range ends only ([\d.]+) mm past", line)
         assert said and float(said.group(1)) == pytest.approx(past * 1000, abs=0.2), line
         assert f"[gripper.joints.{jaw}] stiffness" in line
+        said = re.search(r"presses with at most ([\d.]+) N there", line)  # K x 15 mm and the 2 % holding force
+        assert said and float(said.group(1)) == pytest.approx(effort / full_error * past + 0.02 * effort, rel=0.02)
     consistent_exit(code, text)
 
 

@@ -505,7 +505,8 @@ class Gripper:
                               f"({d.stiffness:.4g} {k}) needs {d.full_error:.3g} {self.unit[name]} of following error for "
                               f"it, more than {PAST_REACH:g} times the joint's range ({hi - lo:.3g} {self.unit[name]}): a "
                               f"finger presses with "
-                              f"at most {d.stiffness * (hi - lo):.3g} {u}. A placeholder? Give the drive's real effort in "
+                              f"at most {d.stiffness * (hi - lo) + d.hold:.3g} {u} (with its holding force). A placeholder? Give "
+                              f"the drive's real effort in "
                               f"[gripper.joints.{name}] effort")
         return notes
 

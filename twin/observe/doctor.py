@@ -27,6 +27,7 @@ from pathlib import Path
 from twin.core.errors import MotionError
 from twin.core.bullet import pybullet
 from twin.core.geometry import Pose, cross
+from twin.core.gripper import PAST_REACH
 from twin.core.signal_table import IN_POSITION_TOLERANCE
 from twin.core.world import STEEL_DENSITY as STEEL, link_volume
 
@@ -834,22 +835,28 @@ class Doctor:
                 f"{'and' if r.weight_along > 0 else 'less'} {abs(r.weight_along):.4g} {unit} of the weight it moves)")
 
     def range_hint(self, r: FingerResult) -> str:
-        """Why a finger presses short of its effort where its drive's range ends too close past the part: a stalled
-        drive presses with its stiffness times how far its command lies past where it stands (docs/station-format.md,
-        the drive model), and the doctor commands the range's end."""
+        """Why a finger presses short of its effort where its drive's spring is too soft for its range: a stalled drive
+        presses with its stiffness times how far its command lies past where it stands, and its holding force
+        (docs/station-format.md, the drive model); the doctor commands the range's end, and only a drive whose
+        full-force error is within PAST_REACH times its range presses past it with its whole effort."""
         drive = self.g.drives[r.drive]
         if r.short_of_goal is None or drive.rigid:
             return ""
-        most = drive.stiffness * r.short_of_goal
-        if most >= (1 - FORCE_TOLERANCE) * self.g.chain_effort(r.drive):
+        most = drive.stiffness * r.short_of_goal + drive.hold
+        effort = self.g.chain_effort(r.drive)
+        if most >= (1 - FORCE_TOLERANCE) * effort:
             return ""
-        unit = self.unit[r.drive]
-        spring, u = ((f"{drive.stiffness / 1000:.4g} N/mm", "N") if unit == "m"
-                     else (f"{drive.stiffness / 1000:.4g} N m/mrad", "N m"))
+        unit, inp = self.unit[r.drive], self.mech.input(r.drive)
+        span = inp.max - inp.min
+        spring, u, k = ((f"{drive.stiffness / 1000:.4g} N/mm", "N", "N/m") if unit == "m"
+                        else (f"{drive.stiffness / 1000:.4g} N m/mrad", "N m", "N m/rad"))
         return (f": its range ends only {_fmt_len(r.short_of_goal, unit)} past where {r.drive} stands on the part, "
-                f"and its drive's spring ({spring}) presses with at most {most:.4g} {u} there; a range that reaches "
-                f"{_fmt_len(self.g.chain_effort(r.drive) / drive.stiffness, unit)} past the part (or a stiffer drive: "
-                f"[gripper.joints.{r.drive}] stiffness) gives the whole effort")
+                f"and its drive's spring ({spring}) presses with at most {most:.4g} {u} there (with its "
+                f"{drive.hold:.3g} {u} holding force); its full-force error, {_fmt_len(effort / drive.stiffness, unit)}, "
+                f"is more than {PAST_REACH:g} times its range ({_fmt_len(span, unit)}), so it does not press past its "
+                f"range's end: a stiffer drive ([gripper.joints.{r.drive}] stiffness, at least "
+                f"{effort / (PAST_REACH * span):.4g} {k}) or a range of {_fmt_len(effort / drive.stiffness / PAST_REACH, unit)} "
+                "gives the whole effort")
 
     def judge(self, where, want, status, res, moving, result, mu) -> None:
         # the grip closes when its last finger touches: one that touched first pushes an off-centre part over to the
