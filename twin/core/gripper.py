@@ -55,7 +55,6 @@ The grip rule (`sense`, after each step), the same for outside and inside grips:
 from __future__ import annotations
 
 import collections
-import logging
 import math
 from dataclasses import dataclass, field
 
@@ -68,7 +67,7 @@ from .signal_table import DEFAULT_EFFORT, IN_POSITION_TOLERANCE, MOVING_SPEED, M
 # signals mean)
 from .signals import FLOAT, INPUT, SignalSpec
 from .station import GripperSpec
-from .world import COLLISION_MARGIN
+from .world import COLLISION_MARGIN, warn_once
 
 DEFAULT_VELOCITY = {"m": 0.1, "rad": 1.0}  # when the URDF gives no velocity limit
 FULL_FORCE_ERROR = {"m": 0.001, "rad": 0.01}  # default stiffness: the effort limit at this following error ...
@@ -121,15 +120,6 @@ ARRIVAL_DEPTH = 0.00002  # m: ... and its last substep before the part lands it 
 # exist once shapes overlap; a contact flag must not rise a step late)
 ARRIVAL_BRAKING = 0.5  # the share of a drive's effort over its own links' mass that slowing down for a part may ask
 CONTACT_SLACK = 0.00005  # m: pybullet holds pressed contacts up to 0.02 mm apart; a pressing finger within this touches
-_warned_efforts: set[str] = set()  # each unreachable or defaulted limit warned of once per process
-
-
-def _warn_once(notes: list[str], note: str) -> None:
-    """Add `note` to `notes`, and log it as a warning the first time this process meets it."""
-    notes.append(note)
-    if note not in _warned_efforts:
-        _warned_efforts.add(note)
-        logging.getLogger("twin").warning("warning: %s", note)
 STATUS_MOVING, STATUS_OPENING_CONTACT, STATUS_CLOSING_CONTACT, STATUS_AT_SETPOINT = 0, 1, 2, 3
 
 
@@ -243,7 +233,6 @@ class Gripper:
         self._constants: list[tuple] | None = None  # what `drive` asks of each drive at every substep, formed once
         # one line per drive limit the station runs with but does not give, or cannot reach: (the limit, the line)
         self.limit_notes = self._defaulted_limits(defaulted) + [("effort", n) for n in self._unreachable_efforts()]
-        self.effort_notes = [note for _, note in self.limit_notes]
         self.revolute_fingers = {f.name for f in mechanism.fingers
                                  if client.getJointInfo(body, joint_index[f.joint])[2] == pybullet.JOINT_REVOLUTE}
         self.grip_force = {f: spec.grip_force if spec.grip_force is not None
@@ -473,18 +462,23 @@ class Gripper:
         self.spring_sweeps = max((self.drives[n].stiffness * h * h / self.drives[n].own for n in own_drives
                                   if not self.drives[n].rigid), default=0.0)
 
+    @property
+    def effort_notes(self) -> list[str]:
+        """The lines of `limit_notes` (`twin info`'s warnings)."""
+        return [note for _, note in self.limit_notes]
+
     def _defaulted_limits(self, defaulted: list[tuple[JointInput, str]]) -> list[tuple[str, str]]:
         """One warning line per drive limit that neither the URDF (a joint's <limit> velocity or effort missing, or 0,
         as exporters leave them) nor the station gives (`defaulted`: (input, "velocity" or "effort")): the default the
         drive runs with, and where to give the real one: (the limit, the line)."""
-        notes, lines = [], []
+        notes = []
         for inp, what in defaulted:
             value = getattr(self.drives[inp.name], what)
             unit = f"{inp.unit}/s" if what == "velocity" else "N" if inp.unit == "m" else "N m"
             line = (f"{self.spec.urdf}: joint {inp.joint} (input {inp.name}) has no {what} limit (missing or 0): its "
                     f"drive runs with {value:g} {unit}; give the real one in the URDF's <limit {what}=...> or in "
                     f"[gripper.joints.{inp.name}] {what}")
-            _warn_once(lines, line)
+            warn_once(str(self.spec.urdf), line, line)
             notes.append((what, line))
         return notes
 
@@ -500,14 +494,14 @@ class Gripper:
                 continue
             m = self.unit[name] == "m"
             u, k = ("N", "N/m") if m else ("N m", "N m/rad")
-            _warn_once(notes, f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest "
-                              f"position loop the {self.h * 1000:g} ms substep keeps stable for what it moves "
-                              f"({d.stiffness:.4g} {k}) needs {d.full_error:.3g} {self.unit[name]} of following error for "
-                              f"it, more than {PAST_REACH:g} times the joint's range ({hi - lo:.3g} {self.unit[name]}): a "
-                              f"finger presses with "
-                              f"at most {d.stiffness * (hi - lo) + d.hold:.3g} {u} (with its holding force). A placeholder? Give "
-                              f"the drive's real effort in "
-                              f"[gripper.joints.{name}] effort")
+            line = (f"{self.spec.urdf}: input {name}: effort {d.effort:g} {u} cannot be reached: the stiffest position "
+                    f"loop the {self.h * 1000:g} ms substep keeps stable for what it moves ({d.stiffness:.4g} {k}) needs "
+                    f"{d.full_error:.3g} {self.unit[name]} of following error for it, more than {PAST_REACH:g} times "
+                    f"the joint's range ({hi - lo:.3g} {self.unit[name]}): a finger presses with at most "
+                    f"{d.stiffness * (hi - lo) + d.hold:.3g} {u} (with its holding force). A placeholder? Give the "
+                    f"drive's real effort in [gripper.joints.{name}] effort")
+            warn_once(str(self.spec.urdf), line, line)
+            notes.append(line)
         return notes
 
     def _inertia_about_axis(self, name: str, links, finger_links: set[int]) -> tuple[float, float]:
@@ -1129,9 +1123,7 @@ class Gripper:
             m = pybullet.getMatrixFromQuaternion(pose[1])
             for f, joint, axis, in_palm in sliding:
                 if in_palm:
-                    x, y, z = axis
-                    frames[f] = (m[0] * x + m[1] * y + m[2] * z, m[3] * x + m[4] * y + m[5] * z,
-                                 m[6] * x + m[7] * y + m[8] * z)
+                    frames[f] = _turn(m, axis)
                 else:  # (a joint a revolute one turns relative to the palm: its own link's frame)
                     frames[f] = _rotate(self.client.getLinkState(self.body, joint)[5], axis)
         return frames.setdefault(finger, False)
@@ -1153,8 +1145,7 @@ class Gripper:
                 link = info[16]
             if rigid and link == self.palm_link:
                 w = _rotate(c.getLinkState(body, joint, computeForwardKinematics=True)[5], axis)
-                out.append((f, joint, tuple(palm[i] * w[0] + palm[3 + i] * w[1] + palm[6 + i] * w[2]
-                                            for i in range(3)), True))
+                out.append((f, joint, _unturn(palm, w), True))
             else:
                 out.append((f, joint, axis, False))
         return out
@@ -1381,9 +1372,7 @@ class Gripper:
         base_pos, base_orn = self._base_pose()
         p = self.client.getBasePositionAndOrientation(self.targets[name])[0]
         d = (p[0] - base_pos[0], p[1] - base_pos[1], p[2] - base_pos[2])
-        m = pybullet.getMatrixFromQuaternion(base_orn)  # (the palm's rotation; its transpose takes d into the palm)
-        return (m[0] * d[0] + m[3] * d[1] + m[6] * d[2], m[1] * d[0] + m[4] * d[1] + m[7] * d[2],
-                m[2] * d[0] + m[5] * d[1] + m[8] * d[2])
+        return _unturn(pybullet.getMatrixFromQuaternion(base_orn), d)  # (d in the palm's frame)
 
     def _watch_slip(self) -> None:
         """While a part is gripped, still pressed by a finger after its grip was lost (it is sliding out), or lost
@@ -1429,6 +1418,16 @@ class Gripper:
 
 
 def _rotate(orn, v):
-    m = pybullet.getMatrixFromQuaternion(orn)
+    return _turn(pybullet.getMatrixFromQuaternion(orn), v)
+
+
+def _turn(m, v) -> tuple[float, float, float]:
+    """v turned by the rotation matrix m (pybullet's 9 floats, row by row), in plain floats: the hot path's."""
     return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
             m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
+
+
+def _unturn(m, v) -> tuple[float, float, float]:
+    """v turned back by the rotation matrix m (by its transpose): a world vector in the rotated frame."""
+    return (m[0] * v[0] + m[3] * v[1] + m[6] * v[2], m[1] * v[0] + m[4] * v[1] + m[7] * v[2],
+            m[2] * v[0] + m[5] * v[1] + m[8] * v[2])

@@ -57,7 +57,7 @@ class Robot:
         self._handles = 0
         self._corner_failures: set[int] = set()  # zone points that became stop points (their next motion late)
         #: why the last motion ended without arriving (e.g. blocked by a collision), else None
-        self.fault: str | None = None
+        self.failure: MotionError | None = None
         self._clock: PathClock | None = PathClock(0.0)  # the motions' time (None: from the next update)
         self._stored = None  # StorePath: the stopped path and its clock, while a temporary path runs
         self._end_tcp: Pose | None = None
@@ -107,7 +107,7 @@ class Robot:
             raise ValueError(f"expected {len(self.joints)} joint values")
         for j, v in zip(self.joints, q):
             self.client.resetJointState(self.body, j, float(v), 0.0)
-        self._traj, self._queue, self._settled, self._hold, self.fault = None, None, True, q, None
+        self._traj, self._queue, self._settled, self._hold, self.failure = None, None, True, q, None
         self.send(self._command(q, np.zeros_like(q)))
         self.check_kinematics()
 
@@ -159,7 +159,7 @@ class Robot:
         self._queue.add(trajectory, zone, now, self._handles)
         if prev is not None and prev.corner_failure:
             self._corner_failures.add(prev.handle)
-        self._traj, self._settled, self.fault = trajectory, False, None
+        self._traj, self._settled, self.failure = trajectory, False, None
         self._end_tcp = self.kinematics.fk(trajectory.q_end) if self.kinematics is not None else None
         return self._handles
 
@@ -273,11 +273,16 @@ class Robot:
     def paused(self) -> bool:
         return self._paused is not None
 
+    @property
+    def fault(self) -> str | None:
+        """`failure` as text ("target 'NAME': not reached ..."), else None."""
+        return None if self.failure is None else str(self.failure)
+
     def busy(self, t: float) -> bool:
         """True while a motion runs or has not yet settled at its end point.
 
         The end of a motion latches: once in position the robot is idle until the next `start`. If it is
-        not in position `settle_timeout` after the planned end, it sets `fault` and holds where it is.
+        not in position `settle_timeout` after the planned end, it sets `failure` and holds where it is.
         """
         if self._traj is None or self._settled:
             return False
@@ -292,8 +297,8 @@ class Robot:
         elif tau >= end + self.settle_timeout:
             self._settled = True
             off = self.tcp_pose().distance(self._end_tcp) * 1000 if self.kinematics is not None else float("nan")
-            self.fault = (f"target {self._traj.name!r}: not reached {self.settle_timeout:g} s after the motion's end "
-                          f"(TCP {off:.1f} mm away; blocked?)")
+            self.failure = MotionError(self._traj.name, f"not reached {self.settle_timeout:g} s after the motion's end "
+                                                        f"(TCP {off:.1f} mm away; blocked?)")
             self._traj, self._queue, self._hold = None, None, self.q  # stop pushing: hold where it got to
         return not self._settled
 

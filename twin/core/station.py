@@ -8,6 +8,7 @@ Unknown keys are errors too, so a typo never goes unnoticed. The format is docum
 """
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -203,10 +204,8 @@ class _Reader:
 
     def missing(self, name: str, what: str = "") -> StationError:
         """A required key not given; a key given here that reads like it is named (`densty` for `density`)."""
-        import difflib
-
-        given = [k for k in self.table if k not in self.used or k == name]
-        like = difflib.get_close_matches(name, [k for k in given if k != name], n=1, cutoff=0.75)
+        unknown = [k for k in self.table if k not in self.used]
+        like = difflib.get_close_matches(name, unknown, n=1, cutoff=0.75)
         return self.error(name, f"is required{what}" + (f" (is {like[0]!r} a misspelling of it?)" if like else ""))
 
     def has(self, name: str) -> bool:

@@ -372,9 +372,8 @@ class Twin:
             if self.step_count >= limit:
                 raise MotionError(str(kw.get("name") or target), f"still moving after {max_time:g} s")
             self.step()
-        fault = self.robot.fault  # ("target 'NAME': not reached ...": MotionError names the target itself)
-        if fault:
-            raise MotionError(str(kw.get("name") or target), fault.split(": ", 1)[-1])
+        if self.robot.failure is not None:
+            raise self.robot.failure
 
     # -- physical state -----------------------------------------------------------------------------
     @property

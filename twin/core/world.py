@@ -140,7 +140,7 @@ def _unit_axes(root: ET.Element, urdf: Path, file: Path) -> list[tuple[str, str,
                     f"unit vector {' '.join(f'{v:.4g}' for v in unit)} (a URDF axis is a direction: as written it "
                     "would scale the joint's travel and force)")
             fixes.append((name, "axis", note))
-            _warn_once(str(urdf), "joint " + name, note)
+            warn_once(str(urdf), "joint " + name, note)
     return fixes
 
 
@@ -275,7 +275,7 @@ INERTIA_SLACK = 10.0  # a link's inertia more than this many times that of the s
 _warned: set[tuple[str, str]] = set()  # (URDF, link or joint): each warned of once per process
 
 
-def _warn_once(source: str, what: str, note: str) -> None:
+def warn_once(source: str, what: str, note: str) -> None:
     """Log `note` as the twin's warning, once per process for `what` of URDF `source`."""
     if (source, what) not in _warned:
         _warned.add((source, what))
@@ -343,7 +343,7 @@ def fix_inertias(c, body: int, link_name: dict[int, str], source: str, no_inerti
                         f"its {mass:g} kg and collision shapes; using {' '.join(f'{b:.3g}' for b in box)} kg m^2 (the "
                         f"solid box around them)")
             notes.append((name, "mass" if bare else "inertia", note))
-            _warn_once(source, name, note)
+            warn_once(source, name, note)
     return notes
 
 

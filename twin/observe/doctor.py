@@ -82,6 +82,7 @@ class FingerResult:
     force: float | None = None  # mean force while pressing (N or N*m)
     force_range: tuple | None = None
     expected_force: float | None = None
+    effort_share: float | None = None  # of that, the share of its drive's effort that reaches it (N or N m)
     weight_along: float = 0.0  # N: of that, the weight of what its drive moves, along its closing direction
     normal_force: float | None = None  # mean sum of the contact normal forces on the part (N)
     penetration: float | None = None  # m, >= 0: the deepest overlap of the nominal shapes while pressing (into the part)
@@ -802,7 +803,8 @@ class Doctor:
             r.closest = pen[f]
             r.penetration = None if pen[f] is None else max(0.0, -pen[f])
             d = drive_of[f]
-            r.expected_force = g.chain_effort(d) * self.linkage_share(f, d, fingers)  # the weakest in its chain
+            r.effort_share = g.chain_effort(d) * self.linkage_share(f, d, fingers)  # the weakest in its chain
+            r.expected_force = r.effort_share
             if d in g.rigid_linkages:  # knuckles in series: what reaches the finger depends on where it touches
                 r.expected_force = self.knuckle_force(f, d, name, g.chain_effort(d)) or r.expected_force
             r.weight_along = self.weight_along(f, d)
@@ -933,8 +935,7 @@ class Doctor:
 
     def unbalanced(self, res: dict) -> dict:
         """The fingers' efforts (finger -> N or N m) where they differ by more than the force tolerance, else {}."""
-        expected = {f: self.g.chain_effort(r.drive) * self.linkage_share(f, r.drive, list(res))
-                    for f, r in res.items() if r.drive is not None}
+        expected = {f: r.effort_share for f, r in res.items() if r.effort_share is not None}
         if not expected or max(expected.values()) <= (1 + FORCE_TOLERANCE) * min(expected.values()):
             return {}
         return expected
